@@ -1,0 +1,3 @@
+"""rcengine: grey-box RC thermal models of buildings for model predictive control."""
+
+__version__ = "0.1.0"

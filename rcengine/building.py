@@ -1,0 +1,139 @@
+"""Building description (CONTRACT.md §2): location, areas and oriented surfaces."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .exceptions import BuildingError
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A plane surface of the envelope.
+
+    azimuth: degrees clockwise from north (90 = east, 180 = south). [°]
+    tilt: degrees from horizontal (90 = vertical). [°]
+    area: [m²]
+    """
+
+    azimuth: float
+    tilt: float
+    area: float
+
+
+@dataclass(frozen=True)
+class Location:
+    latitude: float
+    longitude: float
+    altitude: float = 0.0
+    timezone: str = "UTC"
+
+
+@dataclass(frozen=True)
+class Building:
+    """One thermal zone as the RC models see it.
+
+    floor_area, wall_area, internal_mass_area: [m²]; volume: [m³].
+    windows / walls: oriented glazing and opaque surfaces (optional).
+    """
+
+    name: str
+    location: Location
+    floor_area: float
+    volume: float
+    wall_area: float
+    internal_mass_area: float
+    windows: tuple[Surface, ...] = field(default_factory=tuple)
+    walls: tuple[Surface, ...] = field(default_factory=tuple)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Building:
+        """Validate and build from the contract JSON; errors name the field."""
+        if not isinstance(data, dict):
+            raise BuildingError("building description must be a JSON object")
+        loc = data.get("location")
+        if not isinstance(loc, dict):
+            raise BuildingError("field 'location' is required: {latitude, longitude, ...}")
+        location = Location(
+            latitude=_number(loc, "latitude", "location.latitude", -90.0, 90.0),
+            longitude=_number(loc, "longitude", "location.longitude", -180.0, 180.0),
+            altitude=_number(loc, "altitude", "location.altitude", -500.0, 9000.0, default=0.0),
+            timezone=_timezone(loc.get("timezone", "UTC")),
+        )
+        return cls(
+            name=str(data.get("name", "building")),
+            location=location,
+            floor_area=_number(data, "floor_area", "floor_area", 1e-3, 1e7),
+            volume=_number(data, "volume", "volume", 1e-3, 1e8),
+            wall_area=_number(data, "wall_area", "wall_area", 1e-3, 1e7),
+            internal_mass_area=_number(
+                data, "internal_mass_area", "internal_mass_area", 0.0, 1e8, default=0.0
+            ),
+            windows=_surfaces(data.get("windows", []), "windows"),
+            walls=_surfaces(data.get("walls", []), "walls"),
+        )
+
+    @classmethod
+    def from_json(cls, path: str | Path) -> Building:
+        try:
+            data = json.loads(Path(path).read_text())
+        except json.JSONDecodeError as exc:
+            raise BuildingError(f"{path}: not valid JSON ({exc})") from exc
+        return cls.from_dict(data)
+
+    def to_dict(self) -> dict[str, Any]:
+        out = asdict(self)
+        out["windows"] = [asdict(s) for s in self.windows]
+        out["walls"] = [asdict(s) for s in self.walls]
+        return out
+
+    def require_windows(self, what: str) -> None:
+        if not self.windows:
+            raise BuildingError(
+                f"{what} needs 'windows' (azimuth, tilt, area) in the building JSON"
+            )
+
+
+def _number(
+    obj: dict, key: str, label: str, lower: float, upper: float, default: float | None = None
+) -> float:
+    if key not in obj or obj[key] is None:
+        if default is None:
+            raise BuildingError(f"field '{label}' is required")
+        return default
+    value = obj[key]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise BuildingError(f"field '{label}' must be a number, got {value!r}")
+    if not lower <= value <= upper:
+        raise BuildingError(f"field '{label}' = {value} is outside [{lower}, {upper}]")
+    return float(value)
+
+
+def _timezone(name: object) -> str:
+    from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+
+    try:
+        ZoneInfo(str(name))
+    except (ZoneInfoNotFoundError, ValueError) as exc:
+        raise BuildingError(f"field 'location.timezone': unknown time zone {name!r}") from exc
+    return str(name)
+
+
+def _surfaces(items: object, label: str) -> tuple[Surface, ...]:
+    if not isinstance(items, list):
+        raise BuildingError(f"field '{label}' must be a list of {{azimuth, tilt, area}}")
+    out = []
+    for i, item in enumerate(items):
+        if not isinstance(item, dict):
+            raise BuildingError(f"field '{label}[{i}]' must be an object")
+        out.append(
+            Surface(
+                azimuth=_number(item, "azimuth", f"{label}[{i}].azimuth", -360.0, 360.0) % 360.0,
+                tilt=_number(item, "tilt", f"{label}[{i}].tilt", 0.0, 180.0),
+                area=_number(item, "area", f"{label}[{i}].area", 0.0, 1e7),
+            )
+        )
+    return tuple(out)

@@ -1,0 +1,121 @@
+"""A validated time series cut into contiguous segments, ready for simulation.
+
+Rows are on a regular step; a missing row (a gap, or weekends removed as in the thesis's
+"Selected period") starts a new segment. Each segment is simulated from its own initial state, so
+a Friday-to-Monday jump is never taken for model error (the flaw of thesis §3.2).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .columns import T_IN
+from .exceptions import DataValidationError, ModelError, Problem
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """Time series on a regular step, indexed by UTC time (row time = start of the interval).
+
+    frame : contract columns plus any derived signals (e.g. ``solar_window``). [SI units]
+    step_s : the regular step. [s]
+    """
+
+    frame: pd.DataFrame
+    step_s: float
+
+    @classmethod
+    def from_frame(cls, frame: pd.DataFrame, step_s: float | None = None) -> Dataset:
+        if not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
+            raise DataValidationError([Problem(None, "time", "index must be tz-aware times")])
+        if len(frame) < 2:
+            raise DataValidationError([Problem(None, None, "need at least two rows")])
+        if not frame.index.is_monotonic_increasing or frame.index.has_duplicates:
+            raise DataValidationError([Problem(None, "time", "times must strictly increase")])
+        if step_s is None:
+            step_s = float(pd.Series(_step_seconds(frame.index)).mode().iloc[0])
+        return cls(frame.tz_convert("UTC"), float(step_s))
+
+    # --- structure ----------------------------------------------------------------------------
+    @property
+    def times(self) -> pd.DatetimeIndex:
+        return self.frame.index
+
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    @property
+    def segments(self) -> list[slice]:
+        """Row slices of the contiguous runs (consecutive rows exactly one step apart)."""
+        breaks = np.flatnonzero(np.abs(_step_seconds(self.frame.index) - self.step_s) > 1e-6) + 1
+        edges = [0, *breaks.tolist(), len(self.frame)]
+        return [slice(a, b) for a, b in itertools.pairwise(edges)]
+
+    # --- selections ---------------------------------------------------------------------------
+    def between(self, start: object = None, end: object = None) -> Dataset:
+        """Rows with start ≤ time < end (either may be None)."""
+        mask = np.ones(len(self.frame), dtype=bool)
+        if start is not None:
+            mask &= self.frame.index >= _utc(start)
+        if end is not None:
+            mask &= self.frame.index < _utc(end)
+        return self._subset(mask)
+
+    def weekdays(self, timezone: str) -> Dataset:
+        """Monday–Friday rows (local calendar), the thesis's "Selected period"."""
+        local = self.frame.index.tz_convert(timezone)
+        return self._subset(np.asarray(local.dayofweek < 5))
+
+    def with_columns(self, extra: pd.DataFrame) -> Dataset:
+        """The same rows with more columns (derived signals), aligned on time."""
+        return Dataset(self.frame.join(extra, how="left", rsuffix="_derived"), self.step_s)
+
+    def _subset(self, mask: np.ndarray) -> Dataset:
+        if not mask.any():
+            raise DataValidationError([Problem(None, "time", "no rows in the selected period")])
+        return Dataset(self.frame.loc[mask], self.step_s)
+
+    # --- arrays -------------------------------------------------------------------------------
+    def inputs(self, names: Sequence[str]) -> np.ndarray:
+        """Input matrix (T, m) in the given column order; every value must be finite."""
+        missing = [n for n in names if n not in self.frame.columns]
+        if missing:
+            raise ModelError(
+                f"the model needs input(s) {missing} that the data do not have "
+                f"(columns: {list(self.frame.columns)})"
+            )
+        u = self.frame[list(names)].to_numpy(dtype=float)
+        bad_rows, bad_cols = np.nonzero(~np.isfinite(u))
+        if bad_rows.size:
+            problems = [
+                Problem(int(r), names[c], "input value missing or not finite")
+                for r, c in zip(bad_rows[:20], bad_cols[:20], strict=True)
+            ]
+            raise DataValidationError(problems)
+        return u
+
+    @property
+    def measured(self) -> np.ndarray:
+        """Measured indoor temperature (T,), NaN where not measured. [°C]"""
+        if T_IN not in self.frame.columns:
+            return np.full(len(self.frame), np.nan)
+        return self.frame[T_IN].to_numpy(dtype=float)
+
+
+def _step_seconds(index: pd.DatetimeIndex) -> np.ndarray:
+    """Differences between consecutive times. [s]"""
+    return np.diff(index.as_unit("ns").asi8) / 1e9
+
+
+def _utc(value: object) -> pd.Timestamp:
+    ts = pd.Timestamp(value)
+    if ts.tzinfo is None:
+        raise DataValidationError(
+            [Problem(None, "time", f"time {value!r} has no UTC offset; write e.g. +01:00")]
+        )
+    return ts.tz_convert("UTC")
