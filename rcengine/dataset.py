@@ -69,7 +69,7 @@ class Dataset:
     def weekdays(self, timezone: str) -> Dataset:
         """Monday–Friday rows (local calendar), the thesis's "Selected period"."""
         local = self.frame.index.tz_convert(timezone)
-        return self._subset(np.asarray(local.dayofweek < 5))
+        return self._subset(np.asarray(local.day_of_week < 5))
 
     def with_columns(self, extra: pd.DataFrame) -> Dataset:
         """The same rows with more columns (derived signals), aligned on time."""

@@ -60,6 +60,20 @@ PRESETS: dict[str, EstimatorSettings] = {
 }
 
 
+@dataclass(frozen=True)
+class Identifiability:
+    """singular_ratios: σ_k/σ_max of the relative-sensitivity Jacobian (keyed by the free parameter
+    names only for reading; the directions are combinations); flat_directions: exponents w such
+    that scaling each θ_j by exp(t·w_j) leaves the output unchanged."""
+
+    singular_ratios: dict[str, float]
+    flat_directions: list[dict[str, float]]
+
+    @property
+    def identifiable(self) -> bool:
+        return not self.flat_directions
+
+
 def settings_for(preset: str | EstimatorSettings) -> EstimatorSettings:
     if isinstance(preset, EstimatorSettings):
         return preset
@@ -202,6 +216,32 @@ class Estimator:
         self.polish_ = {"cost_gps": gps_cost, "cost_polished": after, "improved": bool(improved)}
         return (x, after) if improved else (gps_x, gps_cost)
 
+    def identifiability(self, rel_step: float = 1e-5, threshold: float = 1e-4) -> Identifiability:
+        """Which parameter combinations the data pin down, from the residual Jacobian.
+
+        Columns are ∂r/∂ln θ_j (relative sensitivities, one batched simulation). A right singular
+        vector v with σ/σ_max below ``threshold`` is a direction along which the output does not
+        change: scaling the parameters by exp(t·v) leaves the fit intact, so only the products
+        Π θ_j^{w_j} orthogonal to v are identifiable.
+        """
+        self._check_fitted()
+        space, objective = self.space_, self.objective_
+        theta = np.array([self.params_[p] for p in space.network.param_names])
+        free = [space.network.param_names.index(p) for p in space.free]
+        points = np.tile(theta, (len(free) + 1, 1))
+        for row, j in enumerate(free, start=1):
+            points[row, j] *= 1.0 + rel_step
+        res = objective.residuals(points)
+        jac = (res[1:] - res[0]) / np.log1p(rel_step)
+        _, sv, vt = np.linalg.svd(jac.T, full_matrices=False)
+        ratio = sv / sv[0] if sv[0] > 0 else np.zeros_like(sv)
+        flat = [
+            {name: float(c) for name, c in zip(space.free, v, strict=True) if abs(c) > 1e-3}
+            for v, r in zip(vt, ratio, strict=True)
+            if r < threshold
+        ]
+        return Identifiability(dict(zip(space.free, ratio.tolist(), strict=False)), flat)
+
     def _check_fitted(self) -> None:
         if not hasattr(self, "params_"):
             raise NotFittedError("call fit() before using the estimator")
@@ -210,4 +250,3 @@ class Estimator:
         """Fitted model over ``data`` with initial states estimated from its measurements."""
         self._check_fitted()
         return Objective(self.compiled, data, self.cost).trajectory(self.params_)
-

@@ -32,7 +32,7 @@ All assembly is vectorised over a population of parameter sets (leading axis S).
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -170,6 +170,37 @@ class RCNetwork:
         self.output = node
         return self
 
+    def to_dict(self) -> dict:
+        """JSON-ready description; ``from_dict`` rebuilds the same network."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "parameters": [asdict(p) for p in self.parameters.values()],
+            "capacitors": [asdict(c) for c in self.capacitors],
+            "massless": list(self.massless),
+            "temperatures": list(self.temperatures),
+            "resistors": [asdict(r) for r in self.resistors],
+            "heat_inputs": [asdict(h) for h in self.heat_inputs],
+            "output": self.output,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> RCNetwork:
+        try:
+            return cls(
+                name=data["name"],
+                description=data.get("description", ""),
+                parameters={p["name"]: Parameter(**p) for p in data["parameters"]},
+                capacitors=[Capacitor(**c) for c in data["capacitors"]],
+                massless=list(data.get("massless", [])),
+                temperatures=list(data["temperatures"]),
+                resistors=[Resistor(**r) for r in data["resistors"]],
+                heat_inputs=[HeatInput(**h) for h in data["heat_inputs"]],
+                output=data["output"],
+            )
+        except (KeyError, TypeError) as exc:
+            raise ModelError(f"invalid network description: {exc}") from exc
+
     def copy(self, name: str | None = None) -> RCNetwork:
         """A deep copy to extend without touching the original."""
         new = copy.deepcopy(self)
@@ -290,9 +321,9 @@ class CompiledNetwork:
     @staticmethod
     def _values(theta: np.ndarray, columns: tuple) -> np.ndarray:
         idx, fixed, factor = columns
-        if idx.size == 0:
-            return np.zeros((theta.shape[0], 0))
-        vals = np.where(idx >= 0, theta[:, np.maximum(idx, 0)], fixed)
+        vals = np.tile(fixed, (theta.shape[0], 1))
+        named = idx >= 0
+        vals[:, named] = theta[:, idx[named]]
         return vals * factor
 
     def as_theta(self, params: dict[str, float] | np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from .simulate import ModalSystem, free_response, modal_system, simulate_modal
 
 COSTS = ("mse", "nmse")
 # Relative ridge on the profiled initial states [1/step]; see module docstring.
-_RIDGE_PER_STEP = 1e-4
+_RIDGE_PER_STEP = 1e-6
 # Profiled initial temperatures stay within this band around the prior. [K]
 _MAX_INITIAL_OFFSET_K = 20.0
 # Work budget per population chunk: candidates × time steps.

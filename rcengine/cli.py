@@ -1,0 +1,138 @@
+"""Command line: ``rcengine fit | predict | models`` (CONTRACT.md §3), plus the study and the
+mismatch diagnosis registered by their modules."""
+
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .building import Building
+from .estimate import PRESETS, Estimator
+from .exceptions import ConvergenceWarning, RCEngineError
+from .forecast import forecast
+from .io.timeseries import read_timeseries, write_timeseries
+from .models import available_models, get_model
+from .params import ParameterSet
+from .signals import SignalOptions, prepare
+
+app = typer.Typer(
+    help="Grey-box RC thermal models of buildings: calibrate, forecast, diagnose.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+
+DataArg = Annotated[Path, typer.Argument(help="time-series CSV (CONTRACT.md §1)", exists=True)]
+BuildingOpt = Annotated[
+    Path, typer.Option("--building", "-b", help="building JSON (CONTRACT.md §2)", exists=True)
+]
+
+
+def fail(message: str) -> None:
+    typer.secho(f"error: {message}", fg=typer.colors.RED, err=True)
+    raise typer.Exit(code=2)
+
+
+def _run(fn):
+    """Turn the engine's own errors into a one-line message and exit code 2."""
+    try:
+        return fn()
+    except RCEngineError as exc:
+        fail(str(exc))
+
+
+@app.command()
+def fit(
+    data: DataArg,
+    building: BuildingOpt,
+    model: Annotated[str, typer.Option("--model", "-m", help="model name, see `rcengine models`")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="parameter file to write")],
+    start: Annotated[str | None, typer.Option(help="first time fitted (ISO 8601)")] = None,
+    end: Annotated[str | None, typer.Option(help="end of the fit window (exclusive)")] = None,
+    preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "default",
+    weekdays: Annotated[bool, typer.Option(help="fit Monday–Friday only")] = False,
+    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    sky_model: Annotated[str, typer.Option(help="isotropic | perez | haydavies")] = "isotropic",
+) -> None:
+    """Calibrate MODEL on DATA and write the parameter set as JSON."""
+
+    def run() -> None:
+        b = Building.from_json(building)
+        frame = read_timeseries(data)
+        net = get_model(model, b, frame.columns)
+        options = SignalOptions(sky_model=sky_model)
+        dataset = prepare(frame, b, net.compile().input_names, options).between(start, end)
+        if weekdays:
+            dataset = dataset.weekdays(b.location.timezone)
+        typer.echo(
+            f"fitting {model} on {len(dataset)} rows ({len(dataset.segments)} segment(s)), "
+            f"{dataset.times[0]} → {dataset.times[-1]}"
+        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ConvergenceWarning)
+            est = Estimator(net, preset=preset, random_state=seed).fit(dataset)
+        params = ParameterSet.from_estimator(est, dataset, b, model, options)
+        params.save(output)
+        _print_fit(params, est)
+        for w in caught:
+            typer.secho(f"warning: {w.message}", fg=typer.colors.YELLOW, err=True)
+        typer.echo(f"wrote {output}")
+
+    _run(run)
+
+
+def _print_fit(params: ParameterSet, est: Estimator) -> None:
+    typer.echo(f"{'parameter':<12} {'value':>12}  {'unit':<10} bounds")
+    for name, p in params.compiled.parameters.items():
+        flag = "  ← at bound" if name in est.at_bounds_ else ""
+        bounds = f"[{p.lower:g}, {p.upper:g}]"
+        typer.echo(f"{name:<12} {params.values[name]:>12.4g}  {p.unit:<10} {bounds}{flag}")
+    m = params.metrics["train"]
+    verdict = "pass" if m["ashrae14_pass"] else "fail"
+    typer.echo(
+        f"training RMSE {m['rmse']:.3f} K, MBE {m['mbe']:+.3f} K, CV(RMSE) {m['cv_rmse']:.2f} %, "
+        f"NMBE {m['nmbe']:+.2f} % (ASHRAE Guideline 14: {verdict}); "
+        f"{est.n_simulations_} simulations in {est.wall_time_s_:.2f} s"
+    )
+
+
+@app.command()
+def predict(
+    data: DataArg,
+    params: Annotated[Path, typer.Option("--params", "-p", help="parameter file", exists=True)],
+    start: Annotated[str, typer.Option(help="forecast start (ISO 8601 with offset)")],
+    hours: Annotated[float, typer.Option(help="forecast horizon [h]")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="forecast CSV to write")],
+) -> None:
+    """Forecast indoor temperature from START for HOURS; writes time,t_in_pred."""
+
+    def run() -> None:
+        pset = ParameterSet.load(params)
+        dataset = pset.prepare(read_timeseries(data))
+        fc = forecast(pset.compiled, pset.values, dataset, start, hours)
+        frame = fc.to_frame()
+        write_timeseries(frame, output, pset.building.location.timezone)
+        typer.echo(
+            f"forecast {len(frame)} steps from {frame.index[0]}: t_in_pred "
+            f"{frame.t_in_pred.min():.2f}–{frame.t_in_pred.max():.2f} °C; wrote {output}"
+        )
+
+    _run(run)
+
+
+@app.command()
+def models(
+    as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
+) -> None:
+    """List the model library."""
+    listing = available_models()
+    if as_json:
+        json.dump(listing, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+        return
+    for name, doc in listing.items():
+        typer.echo(f"{name:<8} {doc}")

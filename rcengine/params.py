@@ -1,0 +1,159 @@
+"""A calibrated parameter set and its ``params.json``: everything needed to forecast again.
+
+The file holds the network itself (not only its name), so extended models such as
+``basic+window_solar_gains`` from the mismatch diagnosis reload exactly; the building and the
+signal options, so derived inputs (solar gains) are recomputed the same way; the parameter
+values with units and bounds; the fit window, metrics and engine version.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from . import __version__
+from .building import Building
+from .dataset import Dataset
+from .estimate import Estimator
+from .exceptions import ModelError
+from .metrics import evaluate
+from .network import CompiledNetwork, RCNetwork
+from .signals import SignalOptions, prepare
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ParameterSet:
+    """A fitted model: network, values, building, signal options and provenance."""
+
+    model: str
+    network: RCNetwork
+    values: dict[str, float]
+    building: Building
+    signals: SignalOptions = field(default_factory=SignalOptions)
+    fit: dict[str, Any] = field(default_factory=dict)
+    metrics: dict[str, Any] = field(default_factory=dict)
+    engine_version: str = __version__
+    created_at: str = field(default_factory=lambda: datetime.now(UTC).isoformat())
+
+    @property
+    def compiled(self) -> CompiledNetwork:
+        return self.network.compile()
+
+    @classmethod
+    def from_estimator(
+        cls,
+        estimator: Estimator,
+        data: Dataset,
+        building: Building,
+        model: str,
+        signals: SignalOptions | None = None,
+    ) -> ParameterSet:
+        """Collect a fitted estimator's results with its training window and metrics."""
+        net = estimator.compiled
+        fit = {
+            "start": data.times[0].isoformat(),
+            "end": (data.times[-1] + pd.Timedelta(seconds=data.step_s)).isoformat(),
+            "step_s": data.step_s,
+            "rows": len(data),
+            "segments": len(data.segments),
+            "preset": estimator.preset if isinstance(estimator.preset, str) else "custom",
+            "cost": estimator.cost,
+            "cost_value": estimator.cost_,
+            "random_state": estimator.random_state
+            if isinstance(estimator.random_state, int | None)
+            else None,
+            "n_simulations": estimator.n_simulations_,
+            "wall_time_s": estimator.wall_time_s_,
+            "at_bounds": estimator.at_bounds_,
+            "polish": estimator.polish_,
+            "initial_states": {
+                "nodes": list(net.state_names),
+                "per_segment": [s.tolist() for s in estimator.initial_states_],
+            },
+        }
+        metrics = {"train": evaluate(data.measured, estimator.trajectory_.y).to_dict()}
+        return cls(
+            model=model,
+            network=net.network,
+            values=dict(estimator.params_),
+            building=building,
+            signals=signals or SignalOptions(),
+            fit=fit,
+            metrics=metrics,
+        )
+
+    def prepare(self, frame: pd.DataFrame) -> Dataset:
+        """The dataset this model simulates: contract columns plus its derived signals."""
+        return prepare(frame, self.building, self.compiled.input_names, self.signals)
+
+    # --- JSON -----------------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        compiled = self.compiled
+        return {
+            "format_version": FORMAT_VERSION,
+            "engine_version": self.engine_version,
+            "created_at": self.created_at,
+            "model": self.model,
+            "parameters": {
+                p.name: {
+                    "value": self.values[p.name],
+                    "unit": p.unit,
+                    "lower": p.lower,
+                    "upper": p.upper,
+                    "description": p.description,
+                }
+                for p in compiled.parameters.values()
+            },
+            "inputs": list(compiled.input_names),
+            "states": list(compiled.state_names),
+            "fit": self.fit,
+            "metrics": self.metrics,
+            "signals": self.signals.to_dict(),
+            "building": self.building.to_dict(),
+            "network": self.network.to_dict(),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> ParameterSet:
+        try:
+            network = RCNetwork.from_dict(data["network"])
+            values = {name: float(p["value"]) for name, p in data["parameters"].items()}
+            return cls(
+                model=data["model"],
+                network=network,
+                values=values,
+                building=Building.from_dict(data["building"]),
+                signals=SignalOptions(**data.get("signals", {})),
+                fit=data.get("fit", {}),
+                metrics=data.get("metrics", {}),
+                engine_version=data.get("engine_version", "unknown"),
+                created_at=data.get("created_at", ""),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"invalid parameter file: {exc}") from exc
+
+    def save(self, path: str | Path) -> None:
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2, default=_json_default) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> ParameterSet:
+        try:
+            data = json.loads(Path(path).read_text())
+        except json.JSONDecodeError as exc:
+            raise ModelError(f"{path}: not valid JSON ({exc})") from exc
+        return cls.from_dict(data)
+
+
+def _json_default(value: object) -> object:
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if hasattr(value, "item"):
+        return value.item()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

@@ -1,0 +1,112 @@
+"""RC network compilation against matrices written out by hand."""
+
+import numpy as np
+import pytest
+
+from rcengine.exceptions import ModelError
+from rcengine.network import Parameter, RCNetwork
+
+
+def two_node() -> RCNetwork:
+    net = RCNetwork("2R2C")
+    for name in ("r1", "r2", "c1", "c2", "g"):
+        net.add_parameter(Parameter(name, "-", 1e-6, 1e9))
+    net.add_capacitor("wall", "c1", factor=10.0)  # C = 10·c1
+    net.add_capacitor("air", "c2")
+    net.add_resistor("t_out", "wall", "r1", factor=0.5)  # R = 0.5·r1
+    net.add_resistor("wall", "air", "r2")
+    net.add_heat_input("ghi", "wall", "g")
+    net.add_heat_input("q_hvac", "air")
+    net.set_output("air")
+    return net
+
+
+def test_compiled_matrices_match_hand_written_balances():
+    r1, r2, c1, c2, g = 0.02, 0.01, 3e5, 2e6, 7.0
+    A, B, C, D = two_node().compile().state_space({"r1": r1, "r2": r2, "c1": c1, "c2": c2, "g": g})
+    R1, C1 = 0.5 * r1, 10.0 * c1
+    # C1 dTw/dt = (t_out − Tw)/R1 + (Ta − Tw)/r2 + g·ghi ;  c2 dTa/dt = (Tw − Ta)/r2 + q_hvac
+    A_hand = np.array([[-(1 / R1 + 1 / r2) / C1, 1 / (r2 * C1)], [1 / (r2 * c2), -1 / (r2 * c2)]])
+    B_hand = np.array([[1 / (R1 * C1), g / C1, 0.0], [0.0, 0.0, 1 / c2]])
+    np.testing.assert_allclose(A[0], A_hand, rtol=1e-12)
+    np.testing.assert_allclose(B[0], B_hand, rtol=1e-12)
+    np.testing.assert_array_equal(C[0], [0.0, 1.0])
+    np.testing.assert_array_equal(D[0], [0.0, 0.0, 0.0])
+
+
+def test_input_order_and_shared_signal():
+    net = two_node()
+    net.add_heat_input("ghi", "air", 0.25)  # the same signal into a second node, fixed gain
+    cn = net.compile()
+    assert cn.input_names == ("t_out", "ghi", "q_hvac")
+    _, B, _, _ = cn.state_space(np.ones((1, 5)))
+    assert B[0, 1, 1] == pytest.approx(0.25 / 1.0)
+
+
+def test_population_axis():
+    cn = two_node().compile()
+    theta = np.array([[0.02, 0.01, 3e5, 2e6, 7.0], [0.04, 0.01, 3e5, 2e6, 7.0]])
+    A, _, _, _ = cn.state_space(theta)
+    assert A.shape == (2, 2, 2)
+    assert A[1, 0, 0] > A[0, 0, 0]  # doubled outer resistance couples less to outdoors
+
+
+def test_massless_node_is_eliminated_exactly():
+    # t_out —R1— s (massless) —R2— air (C), heat q into s.
+    # Then s = (t_out/R1 + T/R2 + q)/(1/R1+1/R2)
+    # and C dT/dt = (s − T)/R2 = (t_out − T)/(R1+R2) + q·R1/(R1+R2).
+    net = RCNetwork("massless")
+    net.add_capacitor("air", 1e6)
+    net.add_node("s")
+    net.add_resistor("t_out", "s", 0.01)
+    net.add_resistor("s", "air", 0.03)
+    net.add_heat_input("q", "s")
+    net.set_output("s")
+    A, B, C, D = net.compile().state_space(np.zeros((1, 0)))
+    np.testing.assert_allclose(A[0], [[-1 / (0.04 * 1e6)]])
+    np.testing.assert_allclose(B[0], [[1 / (0.04 * 1e6), 0.01 / 0.04 / 1e6]])
+    # output s = (t_out/R1 + T/R2 + q) / (1/R1 + 1/R2)
+    g = 1 / 0.01 + 1 / 0.03
+    np.testing.assert_allclose(C[0], [(1 / 0.03) / g])
+    np.testing.assert_allclose(D[0], [(1 / 0.01) / g, 1 / g])
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda n: n.add_capacitor("x", "missing"), "unknown parameter 'missing'"),
+        (lambda n: n.add_capacitor("wall", 1.0), "node 'wall' already exists"),
+        (lambda n: n.add_heat_input("q", "nowhere"), "unknown node 'nowhere'"),
+        (lambda n: n.add_resistor("wall", "wall", 1.0), "to itself"),
+        (lambda n: n.add_capacitor("x", -1.0), "finite and ≥ 0"),
+    ],
+)
+def test_construction_errors(build, message):
+    with pytest.raises(ModelError, match=message):
+        build(two_node())
+
+
+def test_floating_node_is_rejected():
+    net = two_node()
+    net.add_capacitor("island", 1.0)
+    with pytest.raises(ModelError, match="no resistive path"):
+        net.compile()
+
+
+def test_missing_output_and_parameters():
+    net = RCNetwork("x")
+    net.add_capacitor("a", 1.0)
+    net.add_resistor("a", "t_out", 1.0)
+    with pytest.raises(ModelError, match="no output"):
+        net.compile()
+    with pytest.raises(ModelError, match="missing parameter"):
+        two_node().compile().as_theta({"r1": 1.0})
+
+
+def test_extension_leaves_original_untouched():
+    base = two_node()
+    extended = base.copy("extended")
+    extended.add_capacitor("emitter", 1e5)
+    extended.add_resistor("emitter", "air", 0.01)
+    assert base.compile().n_states == 2
+    assert extended.compile().n_states == 3
