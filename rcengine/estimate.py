@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -72,6 +72,18 @@ class Identifiability:
     @property
     def identifiable(self) -> bool:
         return not self.flat_directions
+
+
+def search(
+    cost: Callable[[np.ndarray], np.ndarray],
+    dim: int,
+    settings: EstimatorSettings,
+    rng: np.random.Generator,
+) -> tuple[ga.GAResult, pattern_search.GPSResult]:
+    """GA over the unit cube, then GPS from its best individual (thesis §2.3.3)."""
+    ga_result = ga.minimize(cost, dim, settings.ga, rng)
+    gps_result = pattern_search.minimize(cost, ga_result.x, ga_result.cost, settings.gps)
+    return ga_result, gps_result
 
 
 def settings_for(preset: str | EstimatorSettings) -> EstimatorSettings:
@@ -157,8 +169,7 @@ class Estimator:
         if space.dim == 0:
             x, best = np.zeros(0), float(cost(np.zeros((1, 0)))[0])
         else:
-            self.ga_ = ga.minimize(cost, space.dim, settings.ga, rng)
-            self.gps_ = pattern_search.minimize(cost, self.ga_.x, self.ga_.cost, settings.gps)
+            self.ga_, self.gps_ = search(cost, space.dim, settings, rng)
             x, best = self.gps_.x, self.gps_.cost
             if settings.polish:
                 starts = [x, *self.ga_.archive[1 : settings.polish_starts]]
