@@ -136,3 +136,43 @@ def models(
         return
     for name, doc in listing.items():
         typer.echo(f"{name:<8} {doc}")
+
+
+@app.command()
+def diagnose(
+    data: DataArg,
+    building: BuildingOpt,
+    model: Annotated[str, typer.Option("--model", "-m", help="baseline model")] = "basic",
+    json_out: Annotated[Path | None, typer.Option("--json", help="JSON report to write")] = None,
+    html_out: Annotated[Path | None, typer.Option("--html", help="HTML report to write")] = None,
+    train_fraction: Annotated[float, typer.Option(help="share of the record fitted")] = 0.5,
+    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+) -> None:
+    """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
+    from .diagnose import DiagnoseSettings
+    from .diagnose import diagnose as run_diagnosis
+    from .diagnose.html import render
+
+    def run() -> None:
+        b = Building.from_json(building)
+        frame = read_timeseries(data)
+        settings = DiagnoseSettings(train_fraction=train_fraction, random_state=seed)
+        report = run_diagnosis(frame, b, model, settings, progress=typer.echo)
+        d = report.to_dict()
+        typer.echo(f"baseline {model}: test RMSE {d['baseline']['rmse_test']:.3f} K")
+        typer.echo(f"where/when: {d['mismatch']['summary']}")
+        for f in report.findings:
+            mark = "ACCEPTED" if f.accepted else "rejected"
+            typer.echo(f"  [{mark}] {f.effect}: {f.explanation}")
+        typer.echo(
+            f"final {d['final']['model']}: test RMSE {d['final']['rmse_test']:.3f} K "
+            f"({report.wall_time_s:.1f} s)"
+        )
+        if json_out:
+            json_out.write_text(report.to_json() + "\n")
+            typer.echo(f"wrote {json_out}")
+        if html_out:
+            html_out.write_text(render(report))
+            typer.echo(f"wrote {html_out}")
+
+    _run(run)

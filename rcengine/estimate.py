@@ -79,9 +79,11 @@ def search(
     dim: int,
     settings: EstimatorSettings,
     rng: np.random.Generator,
+    seeds: np.ndarray | None = None,
 ) -> tuple[ga.GAResult, pattern_search.GPSResult]:
-    """GA over the unit cube, then GPS from its best individual (thesis §2.3.3)."""
-    ga_result = ga.minimize(cost, dim, settings.ga, rng)
+    """GA over the unit cube (``seeds`` in its first generation), then GPS from its best
+    individual (thesis §2.3.3)."""
+    ga_result = ga.minimize(cost, dim, settings.ga, rng, seeds)
     gps_result = pattern_search.minimize(cost, ga_result.x, ga_result.cost, settings.gps)
     return ga_result, gps_result
 
@@ -109,6 +111,8 @@ class Estimator:
         GPS optimum (and other GA basins, see ``EstimatorSettings``) and keep it if it lowers the
         cost; ``polish_`` reports whether it beat GPS. None: the preset decides.
     random_state : seed or Generator; the same seed gives the same result.
+    warm_start : parameter sets (dicts, possibly partial) seeded into the GA's first generation;
+        missing parameters start mid-range. Used to extend a fitted model without losing it.
 
     Attributes (after ``fit``)
     --------------------------
@@ -132,6 +136,7 @@ class Estimator:
         bounds: Mapping[str, tuple[float, float]] | None = None,
         polish: bool | None = None,
         random_state: int | np.random.Generator | None = None,
+        warm_start: list[Mapping[str, float]] | None = None,
     ):
         self.network = network
         self.preset = preset
@@ -142,6 +147,7 @@ class Estimator:
         self.bounds = bounds
         self.polish = polish
         self.random_state = random_state
+        self.warm_start = warm_start
 
     @property
     def compiled(self) -> CompiledNetwork:
@@ -169,7 +175,8 @@ class Estimator:
         if space.dim == 0:
             x, best = np.zeros(0), float(cost(np.zeros((1, 0)))[0])
         else:
-            self.ga_, self.gps_ = search(cost, space.dim, settings, rng)
+            seeds = space.seeds(self.warm_start or [])
+            self.ga_, self.gps_ = search(cost, space.dim, settings, rng, seeds)
             x, best = self.gps_.x, self.gps_.cost
             if settings.polish:
                 starts = [x, *self.ga_.archive[1 : settings.polish_starts]]

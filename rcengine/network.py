@@ -164,6 +164,23 @@ class RCNetwork:
         self.heat_inputs.append(HeatInput(signal, node, gain, factor))
         return self
 
+    def move_heat_input(self, signal: str, from_node: str, to_node: str) -> RCNetwork:
+        """Re-route a heat input (e.g. HVAC heat through a new emitter node instead of the air)."""
+        if to_node not in self.nodes:
+            raise ModelError(f"unknown node '{to_node}' in {self.name}")
+        moved = [h for h in self.heat_inputs if h.signal == signal and h.node == from_node]
+        if not moved:
+            raise ModelError(f"{self.name} has no heat input '{signal}' into '{from_node}'")
+        self.heat_inputs = [
+            HeatInput(h.signal, to_node, h.gain, h.factor) if h in moved else h
+            for h in self.heat_inputs
+        ]
+        return self
+
+    def neighbours(self, node: str) -> list[str]:
+        """Nodes and prescribed temperatures joined to ``node`` by a resistor."""
+        return [r.b if r.a == node else r.a for r in self.resistors if node in (r.a, r.b)]
+
     def set_output(self, node: str) -> RCNetwork:
         if node not in self.nodes:
             raise ModelError(f"output '{node}' is not a node of {self.name}")

@@ -73,6 +73,20 @@ class SearchSpace:
             unit = np.where(hi > lo, (v - lo) / (hi - lo), 0.5)
         return np.clip(unit, 0.0, 1.0)
 
+    def seeds(self, partial: list[Mapping[str, float]]) -> np.ndarray:
+        """Unit-cube points for (possibly partial) parameter dicts; missing values mid-range."""
+        rows = []
+        for values in partial:
+            unit = np.full(self.dim, 0.5)
+            for i, name in enumerate(self.free):
+                if name in values:
+                    theta = self._template.copy()
+                    theta[self._free_idx[i]] = values[name]
+                    theta = np.where(np.isnan(theta), 1.0, theta)
+                    unit[i] = self.to_unit(theta[None, :])[0, i]
+            rows.append(unit)
+        return np.array(rows).reshape(len(rows), self.dim)
+
     def as_dict(self, theta: np.ndarray) -> dict[str, float]:
         return {p: float(v) for p, v in zip(self.network.param_names, theta, strict=True)}
 

@@ -8,14 +8,21 @@ simulates, used by the CLI, the study and the service alike.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
+import numpy as np
 import pandas as pd
 
 from .building import Building
-from .columns import NUMERIC_COLUMNS
+from .columns import NUMERIC_COLUMNS, T_OUT, WIND_SPEED
 from .dataset import Dataset
 from .exceptions import ModelError
+from .ground import ground_temperature
+from .schedules import schedule_signal
+
+# Indoor reference of the air-exchange loss signals: loss ∝ rate × (T_REF − t_out). [°C]
+# The true indoor temperature varies by a few kelvin around it; the fitted gain absorbs the mean.
+T_REF_C = 20.0
 
 
 @dataclass(frozen=True)
@@ -31,6 +38,7 @@ class SignalOptions:
     albedo: float | None = None
     iam_model: str = "physical"
     decomposition: str = "erbs"
+    schedules: dict[str, list[float]] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -52,13 +60,63 @@ def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> p
     )
 
 
+def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
+    if column not in frame.columns or not frame[column].notna().any():
+        raise ModelError(f"signal '{signal}' needs the column '{column}', absent from the data")
+    return frame[column].to_numpy(dtype=float)
+
+
+def _air_exchange(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """wind_loss = wind_speed · (t_out − T_REF) [m/s·K]; vent_loss = sched · (t_out − T_REF) [K]."""
+    t_out = frame[T_OUT].to_numpy(dtype=float)
+    out = pd.DataFrame(index=frame.index)
+    if WIND_SPEED in frame.columns:
+        out["wind_loss"] = _require(frame, WIND_SPEED, "wind_loss") * (t_out - T_REF_C)
+    if "vent" in options.schedules:
+        schedule = schedule_signal(
+            options.schedules["vent"], frame.index, building.location.timezone
+        )
+        out["vent_loss"] = schedule * (t_out - T_REF_C)
+    return out
+
+
+def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """sched_<name>: a stored weekly schedule played back in local time. [-]"""
+    tz = building.location.timezone
+    return pd.DataFrame(
+        {
+            f"sched_{name}": schedule_signal(p, frame.index, tz)
+            for name, p in options.schedules.items()
+        },
+        index=frame.index,
+    )
+
+
+def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    step = float(np.median(np.diff(frame.index.as_unit("s").asi8)))
+    return pd.DataFrame(
+        {"t_ground": ground_temperature(frame[T_OUT].to_numpy(), step)}, index=frame.index
+    )
+
+
+def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
+    from .sky import daily_cloud_cover, sky_temperature
+
+    t_out = frame[T_OUT].to_numpy(dtype=float)
+    cover = daily_cloud_cover(frame, building.location)
+    return pd.DataFrame({"sky_delta": sky_temperature(t_out, cover) - t_out}, index=frame.index)
+
+
 # Prefix of a derived signal name → the function computing every signal of that family.
-DERIVERS: dict[str, Deriver] = {"solar_": _solar}
-
-
-def register(prefix: str, deriver: Deriver) -> None:
-    """Make signals named ``prefix…`` derivable (used by the mismatch diagnosis)."""
-    DERIVERS[prefix] = deriver
+DERIVERS: dict[str, Deriver] = {
+    "solar_": _solar,
+    "wind_loss": _air_exchange,
+    "vent_loss": _air_exchange,
+    "sched_": _schedules,
+    "t_ground": _ground,
+    "sky_delta": _sky,
+}
 
 
 def derive(

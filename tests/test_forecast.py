@@ -45,7 +45,7 @@ def test_missing_future_inputs_are_named(four_days):
     frame.loc[frame.index[3 * 96 + 5], "t_out"] = np.nan
     data = Dataset(frame, 900.0)
     net = get_model("basic", BUILDING).compile()
-    with pytest.raises(DataValidationError, match="t_out.*missing at 1 forecast time"):
+    with pytest.raises(DataValidationError, match=r"t_out.*missing at 1 forecast time"):
         forecast(net, TRUTH_BASIC, data, data.times[3 * 96], hours=12)
 
 

@@ -64,7 +64,7 @@ def test_absent_gain_columns_are_left_out_not_zeroed():
 
 
 def test_unknown_model_lists_choices():
-    with pytest.raises(ModelError, match="invalid model 'cube'.*basic"):
+    with pytest.raises(ModelError, match=r"invalid model 'cube'.*basic"):
         get_model("cube", BUILDING)
     assert {"basic", "sun", "1r1c", "2r2c", "5r1c"} <= set(available_models())
 

@@ -1,0 +1,400 @@
+"""Candidate physics: one physically shaped extension of the RC network per effect id.
+
+Each candidate builds, from the data and the building JSON, what the model would need to represent
+one missing effect — a new input with a bounded gain, a new node, or a new resistance to a new
+boundary temperature — or says why it cannot be built (its inputs are missing). The effect ids are
+the contract's vocabulary (CONTRACT.md §3).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from ..building import Building
+from ..columns import Q_HVAC, T_OUT, WIND_SPEED
+from ..network import Parameter, RCNetwork
+from ..schedules import describe, on_hours, weekly_profile
+from ..signals import T_REF_C, SignalOptions
+
+AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
+
+
+@dataclass(frozen=True)
+class Extension:
+    """The extended network, the signal options it needs, its new parameters and the facts an
+    explanation quotes (orientations, areas, schedules ...)."""
+
+    effect: str
+    network: RCNetwork
+    signals: SignalOptions
+    new_parameters: tuple[str, ...]
+    inputs: tuple[tuple[str, str], ...] = ()  # (signal, node) of new heat inputs, for screening
+    structural: bool = False  # changes the dynamics (new node / re-routing), screened by a refit
+    detail: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Skipped:
+    effect: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class Context:
+    """What a candidate may look at: the current model and the training data and errors."""
+
+    network: RCNetwork
+    building: Building
+    train: pd.DataFrame  # contract columns, UTC index
+    signals: SignalOptions
+    innovations: np.ndarray  # one-step-ahead Kalman errors on ``train`` (measured − predicted) [K]
+    step_s: float
+
+
+def _name(net: RCNetwork, effect: str) -> str:
+    return f"{net.name}+{effect}"
+
+
+def envelope_node(net: RCNetwork) -> str:
+    """The state exchanging directly with outdoors (wall), else the output node."""
+    outside = [n for n in net.states if n != net.output and T_OUT in net.neighbours(n)]
+    return outside[0] if outside else net.output
+
+
+def mass_node(net: RCNetwork) -> str:
+    """An interior state not touching outdoors (internal mass, floor), else the output node."""
+    inside = [n for n in net.states if n != net.output and T_OUT not in net.neighbours(n)]
+    return inside[0] if inside else net.output
+
+
+def _has_signal(net: RCNetwork, prefix: str) -> bool:
+    return any(s.startswith(prefix) for s in net.signals)
+
+
+def _orientation(azimuth: float, tilt: float) -> str:
+    return f"{azimuth:g}_{tilt:g}"
+
+
+def _facade(azimuth: float, tilt: float) -> str:
+    if tilt < 30:
+        return "roof"
+    names = [
+        "north",
+        "north-east",
+        "east",
+        "south-east",
+        "south",
+        "south-west",
+        "west",
+        "north-west",
+    ]
+    return names[int(((azimuth % 360) + 22.5) // 45) % 8]
+
+
+def window_solar_gains(ctx: Context) -> Extension | Skipped:
+    """Solar heat through the glazing, one gain per façade orientation, into the interior mass."""
+    effect = "window_solar_gains"
+    if not ctx.building.windows:
+        return Skipped(effect, "no windows in the building JSON")
+    if _has_signal(ctx.network, "solar_window"):
+        return Skipped(effect, "the model already has window solar gains")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    target = mass_node(net)
+    groups: dict[str, float] = {}
+    for w in ctx.building.windows:
+        key = _orientation(w.azimuth, w.tilt)
+        groups[key] = groups.get(key, 0.0) + w.area
+    params, inputs = [], []
+    for key, area in groups.items():
+        az, tilt = (float(v) for v in key.split("_"))
+        name = f"g_window_{key}"
+        net.add_parameter(
+            Parameter(
+                name,
+                "-",
+                0.0,
+                0.9,
+                f"share of the irradiance on the {_facade(az, tilt)} glazing ({area:g} m²) "
+                "that heats the zone (solar heat gain coefficient)",
+            )
+        )
+        signal = f"solar_window_{key}"
+        net.add_heat_input(signal, target, name)
+        params.append(name)
+        inputs.append((signal, target))
+    detail = {
+        "orientations": {
+            k: {"area_m2": a, "facade": _facade(*map(float, k.split("_")))}
+            for k, a in groups.items()
+        },
+        "node": target,
+    }
+    return Extension(effect, net, ctx.signals, tuple(params), tuple(inputs), detail=detail)
+
+
+def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
+    """Solar absorbed on the opaque walls and roof by orientation (sol-air), into the envelope."""
+    effect = "opaque_solar_gains"
+    if not ctx.building.walls:
+        return Skipped(effect, "no opaque walls ('walls') in the building JSON")
+    if _has_signal(ctx.network, "solar_opaque"):
+        return Skipped(effect, "the model already has opaque solar gains")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    target = envelope_node(net)
+    groups: dict[str, float] = {}
+    for w in ctx.building.walls:
+        key = _orientation(w.azimuth, w.tilt)
+        groups[key] = groups.get(key, 0.0) + w.area
+    params, inputs = [], []
+    for key, area in groups.items():
+        az, tilt = (float(v) for v in key.split("_"))
+        name = f"a_opaque_{key}"
+        net.add_parameter(
+            Parameter(
+                name,
+                "-",
+                0.0,
+                0.3,
+                f"share of the irradiance on the {_facade(az, tilt)} opaque surfaces ({area:g} m²) "
+                "reaching the envelope node (absorptance × inward fraction)",
+            )
+        )
+        signal = f"solar_opaque_{key}"
+        net.add_heat_input(signal, target, name)
+        params.append(name)
+        inputs.append((signal, target))
+    detail = {
+        "orientations": {
+            k: {"area_m2": a, "facade": _facade(*map(float, k.split("_")))}
+            for k, a in groups.items()
+        },
+        "node": target,
+    }
+    return Extension(effect, net, ctx.signals, tuple(params), tuple(inputs), detail=detail)
+
+
+def wind_infiltration(ctx: Context) -> Extension | Skipped:
+    """Air leakage growing with wind speed: loss = k · wind · (T_in − t_out)."""
+    effect = "wind_infiltration"
+    if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
+        return Skipped(effect, "no wind_speed column in the data")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    upper = AIR_HEAT_CAPACITY_J_M3K * ctx.building.volume / 3600.0  # 1 air change/h per m/s
+    net.add_parameter(
+        Parameter(
+            "k_wind",
+            "W/(K·m/s)",
+            0.0,
+            upper,
+            f"infiltration conductance per m/s of wind: loss = k·wind·({T_REF_C:g} °C − t_out)",
+        )
+    )
+    net.add_heat_input("wind_loss", net.output, "k_wind")
+    detail = {"volume_m3": ctx.building.volume}
+    return Extension(
+        effect, net, ctx.signals, ("k_wind",), (("wind_loss", net.output),), detail=detail
+    )
+
+
+def _learnt_schedule(ctx: Context, values: np.ndarray) -> np.ndarray:
+    return on_hours(
+        np.maximum(weekly_profile(values, ctx.train.index, ctx.building.location.timezone), 0.0)
+    )
+
+
+def ventilation_schedule(ctx: Context) -> Extension | Skipped:
+    """Outdoor-air ventilation in the hours the residuals show an extra loss that grows with
+    the indoor–outdoor difference: loss = h · schedule · (T_in − t_out)."""
+    effect = "ventilation_schedule"
+    if "vent_loss" in ctx.network.signals:
+        return Skipped(effect, "the model already has a ventilation schedule")
+    delta = T_REF_C - ctx.train[T_OUT].to_numpy(dtype=float)
+    # A loss ∝ ΔT makes the model over-predict (negative innovations) in proportion to ΔT.
+    per_kelvin = np.where(delta > 2.0, -ctx.innovations / np.maximum(delta, 2.0), np.nan)
+    schedule = _learnt_schedule(ctx, per_kelvin)
+    if not schedule.any():
+        return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
+    signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "vent": schedule.tolist()})
+    net = ctx.network.copy(_name(ctx.network, effect))
+    upper = AIR_HEAT_CAPACITY_J_M3K * ctx.building.volume * 10.0 / 3600.0  # 10 air changes/h
+    net.add_parameter(
+        Parameter(
+            "h_vent",
+            "W/K",
+            0.0,
+            upper,
+            f"ventilation conductance in the scheduled hours (loss = h · ({T_REF_C:g} °C − t_out))",
+        )
+    )
+    net.add_heat_input("vent_loss", net.output, "h_vent")
+    detail = {"schedule": describe(schedule), "volume_m3": ctx.building.volume}
+    return Extension(effect, net, signals, ("h_vent",), (("vent_loss", net.output),), detail=detail)
+
+
+def unmetered_gains(ctx: Context) -> Extension | Skipped:
+    """Internal gains missing from the data, on the weekly schedule the residuals reveal."""
+    effect = "unmetered_gains"
+    if "sched_gains" in ctx.network.signals:
+        return Skipped(effect, "the model already has an unmetered-gain schedule")
+    schedule = _learnt_schedule(ctx, ctx.innovations)
+    if not schedule.any():
+        return Skipped(effect, "the residuals show no weekly pattern of missing heat")
+    signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "gains": schedule.tolist()})
+    net = ctx.network.copy(_name(ctx.network, effect))
+    net.add_parameter(
+        Parameter(
+            "q_unmetered",
+            "W",
+            0.0,
+            60.0 * ctx.building.floor_area,
+            "unmetered internal heat (equipment, people) in the scheduled hours",
+        )
+    )
+    net.add_heat_input("sched_gains", net.output, "q_unmetered")
+    detail = {"schedule": describe(schedule), "floor_area_m2": ctx.building.floor_area}
+    return Extension(
+        effect, net, signals, ("q_unmetered",), (("sched_gains", net.output),), detail=detail
+    )
+
+
+def ground_coupling(ctx: Context) -> Extension | Skipped:
+    """Heat exchange through the floor with the slowly varying ground temperature."""
+    effect = "ground_coupling"
+    if "t_ground" in ctx.network.signals:
+        return Skipped(effect, "the model already has ground coupling")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    floor = ctx.building.floor_area
+    target = mass_node(net)
+    net.add_parameter(
+        Parameter(
+            "r_ground",
+            "m²K/W",
+            0.05,
+            50.0,
+            "resistance between the floor/interior mass and the ground, per floor area",
+        )
+    )
+    net.add_resistor("t_ground", target, "r_ground", factor=1.0 / floor)
+    detail = {"node": target, "floor_area_m2": floor}
+    return Extension(
+        effect, net, ctx.signals, ("r_ground",), (("t_ground", target),), detail=detail
+    )
+
+
+def sky_radiation(ctx: Context) -> Extension | Skipped:
+    """Long-wave loss of the envelope to the (cold, clear, night) sky: q = h · (T_sky − t_out)."""
+    effect = "sky_radiation"
+    if "sky_delta" in ctx.network.signals:
+        return Skipped(effect, "the model already has sky radiation")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    target = envelope_node(net)
+    area = ctx.building.floor_area + ctx.building.wall_area  # roof + walls seeing the sky
+    net.add_parameter(
+        Parameter(
+            "h_sky",
+            "W/K",
+            0.0,
+            3.0 * area,
+            "long-wave coupling of the envelope to the sky (≈ ε·h_r·F_sky·A)",
+        )
+    )
+    net.add_heat_input("sky_delta", target, "h_sky")
+    detail = {"node": target}
+    return Extension(effect, net, ctx.signals, ("h_sky",), (("sky_delta", target),), detail=detail)
+
+
+def thermal_mass(ctx: Context) -> Extension | Skipped:
+    """A heat-storage state the model lacks, coupled to the indoor air."""
+    effect = "thermal_mass"
+    net = ctx.network.copy(_name(ctx.network, effect))
+    floor = ctx.building.floor_area
+    node = "mass_extra"
+    net.add_parameter(
+        Parameter(
+            "c_mass_extra",
+            "J/(K·m²)",
+            1e3,
+            1e6,
+            "heat capacity of the added storage, per floor area",
+        )
+    )
+    net.add_parameter(
+        Parameter(
+            "r_mass_extra",
+            "m²K/W",
+            1e-3,
+            5.0,
+            "resistance between the indoor air and the added storage",
+        )
+    )
+    net.add_capacitor(node, "c_mass_extra", factor=floor)
+    net.add_resistor(net.output, node, "r_mass_extra", factor=1.0 / floor)
+    return Extension(
+        effect,
+        net,
+        ctx.signals,
+        ("c_mass_extra", "r_mass_extra"),
+        structural=True,
+        detail={"node": node},
+    )
+
+
+def emitter_dynamics(ctx: Context) -> Extension | Skipped:
+    """HVAC heat reaching the air through an emitter (radiator, slab) with its own inertia."""
+    effect = "emitter_dynamics"
+    q = ctx.train[Q_HVAC].to_numpy(dtype=float) if Q_HVAC in ctx.train.columns else np.zeros(1)
+    if not np.any(np.abs(q) > 0):
+        return Skipped(effect, "q_hvac is zero throughout the training period")
+    direct = [
+        h for h in ctx.network.heat_inputs if h.signal == Q_HVAC and h.node == ctx.network.output
+    ]
+    if not direct:
+        return Skipped(effect, "q_hvac does not enter the air node directly in this model")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    floor = ctx.building.floor_area
+    net.add_parameter(
+        Parameter(
+            "c_emitter",
+            "J/(K·m²)",
+            1e2,
+            5e5,
+            "heat capacity of the emitter (water, metal, screed), per floor area",
+        )
+    )
+    net.add_parameter(
+        Parameter(
+            "r_emitter",
+            "m²K/W",
+            1e-3,
+            1.0,
+            "resistance between the emitter and the indoor air, per floor area",
+        )
+    )
+    net.add_capacitor("emitter", "c_emitter", factor=floor)
+    net.add_resistor("emitter", net.output, "r_emitter", factor=1.0 / floor)
+    net.move_heat_input(Q_HVAC, net.output, "emitter")
+    return Extension(
+        effect,
+        net,
+        ctx.signals,
+        ("c_emitter", "r_emitter"),
+        structural=True,
+        detail={"node": "emitter"},
+    )
+
+
+CANDIDATES: dict[str, Callable[[Context], Extension | Skipped]] = {
+    "window_solar_gains": window_solar_gains,
+    "opaque_solar_gains": opaque_solar_gains,
+    "wind_infiltration": wind_infiltration,
+    "ventilation_schedule": ventilation_schedule,
+    "ground_coupling": ground_coupling,
+    "sky_radiation": sky_radiation,
+    "unmetered_gains": unmetered_gains,
+    "thermal_mass": thermal_mass,
+    "emitter_dynamics": emitter_dynamics,
+}

@@ -1,0 +1,172 @@
+"""HTML rendering of a diagnosis: one self-contained page, figures embedded as PNG."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .locate import DAYS, hour_weekday
+from .report import Finding, Report
+
+_STYLE = """
+body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;color:#222;line-height:1.45}
+h1{font-size:1.6em}h2{margin-top:2em;border-bottom:1px solid #ccc}
+table{border-collapse:collapse}td,th{padding:.3em .7em;border-bottom:1px solid #ddd;text-align:left}
+.ok{color:#0a6d2c;font-weight:600}.no{color:#8a1c1c}.box{background:#f5f7fa;padding:1em;border-radius:6px}
+img{max-width:100%}
+"""
+
+
+def _png(fig: plt.Figure) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    data = base64.b64encode(buf.getvalue()).decode()
+    return f'<img alt="figure" src="data:image/png;base64,{data}">'
+
+
+def _timeseries(report: Report, days: int = 14) -> str:
+    test = report.baseline.split.test
+    local = test.times.tz_convert(report.building.location.timezone)
+    n = min(len(test), int(days * 86400 / test.step_s))
+    fig, ax = plt.subplots(figsize=(11, 3.6))
+    ax.plot(local[:n], test.measured[:n], color="k", lw=1.2, label="measured")
+    ax.plot(
+        local[:n],
+        report.baseline.simulated_test[:n],
+        color="#d62728",
+        lw=1,
+        label=f"{report.model} (test RMSE {report.baseline.rmse_test:.2f} K)",
+    )
+    if report.final is not report.baseline:
+        ax.plot(
+            local[:n],
+            report.final.simulated_test[:n],
+            color="#1f77b4",
+            lw=1,
+            label=f"{report.final.network.name} (test RMSE {report.final.rmse_test:.2f} K)",
+        )
+    ax.set_ylabel("indoor temperature [°C]")
+    ax.set_title(f"Test period, first {days} days: measured vs predicted before and after")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.autofmt_xdate()
+    return _png(fig)
+
+
+def _heatmaps(report: Report) -> str:
+    tz = report.building.location.timezone
+    grids = [("before: " + report.model, report.baseline)]
+    if report.final is not report.baseline:
+        grids.append(("after: " + report.final.network.name, report.final))
+    fig, axes = plt.subplots(1, len(grids), figsize=(5.5 * len(grids), 3.2), squeeze=False)
+    values = [hour_weekday(f.residual_test, f.split.test.times, tz) for _, f in grids]
+    limit = max(0.1, float(np.nanmax([np.nanmax(np.abs(v)) for v in values])))
+    for ax, (title, _), grid in zip(axes[0], grids, values, strict=True):
+        im = ax.imshow(grid, aspect="auto", cmap="RdBu_r", vmin=-limit, vmax=limit)
+        ax.set_yticks(range(7), DAYS)
+        ax.set_xticks(range(0, 24, 3))
+        ax.set_xlabel("hour of day (local)")
+        ax.set_title(f"mean test residual [K], {title}", fontsize=9)
+    fig.colorbar(im, ax=axes[0].tolist(), label="measured − predicted [K]")
+    return _png(fig)
+
+
+def _conditions(report: Report) -> str:
+    block = report.locate["test"]["by_condition"]
+    labels, means = [], []
+    for groups in block.values():
+        for label, stats in groups.items():
+            labels.append(label)
+            means.append(stats["mean_K"])
+    fig, ax = plt.subplots(figsize=(8, 2.8))
+    ax.bar(labels, means, color=["#d62728" if m > 0 else "#1f77b4" for m in means])
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_ylabel("mean residual [K]")
+    ax.set_title("Baseline test residual by condition (positive: model too cold)")
+    return _png(fig)
+
+
+def _evidence(report: Report, finding: Finding) -> str:
+    screen = finding.screen
+    if screen is None:
+        return ""
+    train = report.baseline.split.train  # every model shares the training rows
+    resid = _residual_before(report, finding)
+    n = min(len(train), int(7 * 86400 / train.step_s))
+    local = train.times.tz_convert(report.building.location.timezone)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.2), gridspec_kw={"width_ratios": [2.2, 1]})
+    a1.plot(local[:n], resid[:n], color="k", lw=1, label="residual before")
+    a1.plot(
+        local[:n],
+        screen.response[:n],
+        color="#2ca02c",
+        lw=1,
+        label=f"{finding.effect}: fitted contribution",
+    )
+    a1.legend(fontsize=8)
+    a1.set_ylabel("[K]")
+    a1.set_title("Training residual and what the candidate explains (first week)", fontsize=9)
+    ok = np.isfinite(resid)
+    a2.plot(screen.response[ok][::4], resid[ok][::4], ".", ms=2, alpha=0.4)
+    a2.set_xlabel("candidate contribution [K]")
+    a2.set_ylabel("residual before [K]")
+    fig.autofmt_xdate()
+    return _png(fig)
+
+
+def _residual_before(report: Report, finding: Finding) -> np.ndarray:
+    # The residual the candidate was screened against: the model of the round it was judged in.
+    fits = [report.baseline] + [f.fit for f in report.accepted]
+    return fits[min(finding.round - 1, len(fits) - 1)].residual_train
+
+
+def render(report: Report) -> str:
+    """The report as a standalone HTML page."""
+    d = report.to_dict()
+    esc = html.escape
+    rows = "".join(
+        f"<tr><td>{esc(f['effect'])}</td>"
+        + ("<td class=ok>accepted</td>" if f["accepted"] else "<td class=no>rejected</td>")
+        + f"<td>{f['screening']['explained_share']:.0%}</td>"
+        f"<td>{f['rmse_test_before']:.3f}</td>"
+        f"<td>{'' if f['rmse_test_after'] is None else format(f['rmse_test_after'], '.3f')}</td>"
+        f"<td>{'' if f['delta_bic'] is None else format(f['delta_bic'], '+.1f')}</td>"
+        f"<td>{esc(f['reason'])}</td></tr>"
+        for f in d["findings"]
+    )
+    skipped = "".join(f"<li><b>{esc(k)}</b>: {esc(v)}</li>" for k, v in d["skipped"].items())
+    evidence = "".join(
+        f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_evidence(report, f)}"
+        for f in report.accepted
+    )
+    white = d["whiteness"]
+    return f"""<!doctype html><html><head><meta charset="utf-8">
+<title>Mismatch diagnosis — {esc(report.building.name)}</title><style>{_STYLE}</style></head><body>
+<h1>Mismatch diagnosis — {esc(report.building.name)}</h1>
+<div class="box"><p><b>{esc(d["verdict"])}</b></p>
+<p>Baseline <b>{esc(report.model)}</b>: train RMSE {d["baseline"]["rmse_train"]:.3f} K,
+test RMSE {d["baseline"]["rmse_test"]:.3f} K. Final <b>{esc(d["final"]["model"])}</b>:
+train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
+Training {esc(d["periods"]["train"][0][:10])} – {esc(d["periods"]["train"][1][:10])},
+test until {esc(d["periods"]["test"][1][:10])}.</p>
+<p>Where and when: {esc(d["mismatch"]["summary"])}.</p></div>
+<h2>Measured vs predicted</h2>{_timeseries(report)}
+<h2>Where the errors concentrate</h2>{_heatmaps(report)}{_conditions(report)}
+<h2>Findings</h2><table><tr><th>effect</th><th>verdict</th><th>screening</th>
+<th>test RMSE before [K]</th><th>after [K]</th><th>ΔBIC</th><th>reason</th></tr>{rows}</table>
+<h2>Evidence for accepted findings</h2>{evidence or "<p>None accepted.</p>"}
+<h2>Residual whiteness (Ljung–Box, hourly one-step-ahead errors, 24 lags)</h2>
+<p>Before: Q = {white["baseline"]["q"]:.0f},
+lag-1 h autocorrelation {white["baseline"]["rho_1h"]:.2f};
+after: Q = {white["final"]["q"]:.0f},
+lag-1 h autocorrelation {white["final"]["rho_1h"]:.2f}.</p>
+<h2>Candidates not built</h2><ul>{skipped or "<li>none</li>"}</ul>
+<p><small>rcengine diagnose, {report.wall_time_s:.1f} s.</small></p>
+</body></html>"""

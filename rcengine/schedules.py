@@ -1,0 +1,70 @@
+"""Weekly schedules: 168 hourly values in local time, learnt from data or given.
+
+Office buildings repeat their week; a gain or ventilation rate missing from the data shows up in
+the residuals with that weekly rhythm, so a schedule is the natural shape for such an input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+HOURS_PER_WEEK = 168
+
+
+def hour_of_week(times: pd.DatetimeIndex, timezone: str) -> np.ndarray:
+    """0 = Monday 00:00–01:00 local time … 167 = Sunday 23:00–24:00."""
+    local = times.tz_convert(timezone)
+    return np.asarray(local.day_of_week * 24 + local.hour, dtype=int)
+
+
+def weekly_profile(
+    values: np.ndarray, times: pd.DatetimeIndex, timezone: str
+) -> np.ndarray:
+    """Mean of ``values`` in each hour of the week (168,); hours never seen get 0."""
+    how = hour_of_week(times, timezone)
+    ok = np.isfinite(values)
+    sums = np.bincount(how[ok], weights=values[ok], minlength=HOURS_PER_WEEK)
+    counts = np.bincount(how[ok], minlength=HOURS_PER_WEEK)
+    return np.divide(sums, counts, out=np.zeros(HOURS_PER_WEEK), where=counts > 0)
+
+
+def schedule_signal(
+    profile: np.ndarray, times: pd.DatetimeIndex, timezone: str
+) -> np.ndarray:
+    """The weekly profile played back at ``times``."""
+    profile = np.asarray(profile, dtype=float)
+    if profile.shape != (HOURS_PER_WEEK,):
+        raise ValueError(f"a weekly schedule has {HOURS_PER_WEEK} values, got {profile.shape}")
+    return profile[hour_of_week(times, timezone)]
+
+
+def on_hours(profile: np.ndarray, fraction: float = 0.5) -> np.ndarray:
+    """0/1 schedule: hours whose value exceeds ``fraction`` of the profile's peak."""
+    peak = np.max(profile)
+    if peak <= 0:
+        return np.zeros(HOURS_PER_WEEK)
+    return (profile > fraction * peak).astype(float)
+
+
+def describe(schedule: np.ndarray) -> str:
+    """Plain words for a 0/1 weekly schedule, e.g. "weekdays 08:00–18:00"."""
+    days = ["Mon", "Tue", "Wed", "Thu", "Fri", "Sat", "Sun"]
+    spans = []
+    for d in range(7):
+        hours = np.flatnonzero(schedule[d * 24 : (d + 1) * 24] > 0.5)
+        spans.append(f"{hours[0]:02d}:00–{hours[-1] + 1:02d}:00" if hours.size else None)
+    groups: list[tuple[list[str], str]] = []
+    for day, span in zip(days, spans, strict=True):
+        if span is None:
+            continue
+        follows = groups and days.index(groups[-1][0][-1]) == days.index(day) - 1
+        if follows and groups[-1][1] == span:
+            groups[-1][0].append(day)
+        else:
+            groups.append(([day], span))
+    if not groups:
+        return "never"
+    return ", ".join(
+        f"{g[0]}–{g[-1]} {span}" if len(g) > 1 else f"{g[0]} {span}" for g, span in groups
+    )

@@ -1,0 +1,50 @@
+"""Weekly schedules, the ground-temperature estimate and the sky temperature, by hand."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rcengine.ground import ground_temperature
+from rcengine.schedules import describe, hour_of_week, on_hours, schedule_signal, weekly_profile
+from rcengine.sky import cloud_cover_from_index, sky_temperature
+
+
+def test_hour_of_week_is_local_time():
+    # Monday 2017-01-09 07:00 UTC is 08:00 in Rome (UTC+1).
+    times = pd.DatetimeIndex(["2017-01-09T07:00Z", "2017-01-15T22:30Z"])
+    np.testing.assert_array_equal(hour_of_week(times, "Europe/Rome"), [8, 167])
+
+
+def test_weekly_profile_round_trip_and_description():
+    times = pd.date_range("2017-01-09", periods=4 * 7 * 96, freq="15min", tz="Europe/Rome")
+    truth = np.zeros(168)
+    for day in range(5):
+        truth[day * 24 + 8 : day * 24 + 18] = 1.0
+    signal = schedule_signal(truth, times, "Europe/Rome")
+    profile = weekly_profile(signal + 0.01, times, "Europe/Rome")
+    np.testing.assert_allclose(profile, truth + 0.01)
+    np.testing.assert_array_equal(on_hours(profile), truth)
+    assert describe(truth) == "Mon–Fri 08:00–18:00"
+    with pytest.raises(ValueError, match="168"):
+        schedule_signal(np.ones(24), times, "UTC")
+
+
+def test_ground_temperature_is_a_slow_running_mean():
+    step = 3600.0
+    t_out = np.r_[np.full(24 * 60, 10.0), np.full(24 * 60, 0.0)]
+    g = ground_temperature(t_out, step, tau_days=30)
+    assert g[24 * 60 - 1] == pytest.approx(10.0)
+    # one time constant after the step the soil has covered 1 − 1/e of it
+    assert g[24 * 60 + 24 * 30] == pytest.approx(10.0 * np.exp(-1), rel=0.02)
+    # daily swings are damped by ~1/(2π·30) ≈ 0.5 %
+    daily = 5 * np.sin(np.arange(24 * 90) / 24 * 2 * np.pi)
+    assert np.ptp(ground_temperature(daily, step)[-24 * 10 :]) < 0.2
+
+
+def test_sky_temperature_by_hand():
+    # Swinbank at 0 °C: ε = 9.365e-6 · 273.15² = 0.6987; T_sky = ε^¼ · T
+    t_sky = sky_temperature(np.array([0.0]), np.array([0.0]))[0]
+    assert t_sky == pytest.approx(0.6987**0.25 * 273.15 - 273.15, abs=0.05)
+    overcast = sky_temperature(np.array([0.0]), np.array([10.0]))[0]
+    assert t_sky < overcast < 0.0  # clouds warm the sky, still below the air
+    np.testing.assert_allclose(cloud_cover_from_index(np.array([1.0, 0.25, 0.0])), [0, 10, 10])
