@@ -71,6 +71,11 @@ class Dataset:
         local = self.frame.index.tz_convert(timezone)
         return self._subset(np.asarray(local.day_of_week < 5))
 
+    def on_days(self, days: Sequence[pd.Timestamp]) -> Dataset:
+        """Rows of the given local days (tz-aware midnights); other days become gaps."""
+        local = self.frame.index.tz_convert(days[0].tz).normalize()
+        return self._subset(np.asarray(local.isin(list(days))))
+
     def with_columns(self, extra: pd.DataFrame) -> Dataset:
         """The same rows with more columns (derived signals), aligned on time."""
         return Dataset(self.frame.join(extra, how="left", rsuffix="_derived"), self.step_s)

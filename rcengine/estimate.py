@@ -74,6 +74,11 @@ class Identifiability:
         return not self.flat_directions
 
 
+# Relative tolerances of the least-squares polish: far below any physical significance of the
+# parameters, well above the round-off of the exact simulation.
+POLISH_TOL = 1e-5
+
+
 def search(
     cost: Callable[[np.ndarray], np.ndarray],
     dim: int,
@@ -207,22 +212,37 @@ class Estimator:
         """Trust-region least squares from each start; the best result wins if it beats GPS."""
         h = 1e-6
 
+        last: dict[bytes, np.ndarray] = {}
+
         def residuals(unit: np.ndarray) -> np.ndarray:
-            return np.nan_to_num(objective.residuals(space.to_physical(unit))[0], nan=1e3)
+            res = np.nan_to_num(objective.residuals(space.to_physical(unit))[0], nan=1e3)
+            last.clear()
+            last[unit.tobytes()] = res
+            return res
 
         def jacobian(unit: np.ndarray) -> np.ndarray:
-            # All p forward differences in one batched simulation.
+            # All p forward differences in one batched simulation; the base point is the one
+            # least_squares has just evaluated.
             steps = np.where(unit + h <= 1.0, h, -h)
-            points = np.vstack([unit, unit + np.diag(steps)])
-            res = np.nan_to_num(objective.residuals(space.to_physical(points)), nan=1e3)
-            return ((res[1:] - res[0]) / steps[:, None]).T
+            base = last.get(unit.tobytes())
+            if base is None:
+                base = residuals(unit)
+            res = objective.residuals(space.to_physical(unit + np.diag(steps)))
+            return ((np.nan_to_num(res, nan=1e3) - base) / steps[:, None]).T
 
         gps_x, gps_cost = starts[0], best
         x, after = gps_x, np.inf
         for start in starts:
             try:
                 sol = scipy.optimize.least_squares(
-                    residuals, start, jac=jacobian, bounds=(0.0, 1.0), method="trf"
+                    residuals,
+                    start,
+                    jac=jacobian,
+                    bounds=(0.0, 1.0),
+                    method="trf",
+                    ftol=POLISH_TOL,
+                    xtol=POLISH_TOL,
+                    gtol=POLISH_TOL,
                 )
             except (np.linalg.LinAlgError, ValueError):
                 continue

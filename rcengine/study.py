@@ -1,0 +1,281 @@
+"""The thesis's rolling learn/predict study (§2.4.4, §3), reproduced on any record.
+
+For every day of the season, learn on the previous 1, 3, 5 and 7 days and predict 1, 3 and 7 days
+ahead, for each model, on the "Complete period" (all days) and the "Selected period" (weekdays
+only). In the Selected period the weekends are gaps: training simulates each weekday run from its
+own initial state, and a forecast that spans a weekend restarts on Monday from the state the
+Kalman filter estimates over the (measured) weekend, so Friday never flows into Monday.
+Predictions start from the state filtered over the 48 h of measurements before them.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .building import Building
+from .dataset import Dataset
+from .estimate import Estimator
+from .exceptions import ConvergenceWarning
+from .forecast import forecast
+from .metrics import evaluate, rmse
+from .models import get_model
+from .signals import SignalOptions, prepare
+
+PERIODS = ("complete", "selected")
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """models, learning lengths [d], horizons [d], estimator preset; start/end restrict the days
+    predicted (ISO dates, local); workers: processes (default: every core)."""
+
+    models: tuple[str, ...] = ("basic", "sun")
+    periods: tuple[str, ...] = PERIODS
+    learn_days: tuple[int, ...] = (1, 3, 5, 7)
+    horizons: tuple[int, ...] = (1, 3, 7)
+    preset: str = "default"
+    start: str | None = None
+    end: str | None = None
+    workers: int = field(default_factory=lambda: os.cpu_count() or 1)
+    random_state: int = 0
+
+
+@dataclass(frozen=True)
+class Task:
+    model: str
+    period: str
+    day: pd.Timestamp  # local midnight of the first predicted day
+
+
+# Per-process state: the prepared record of each model (set by _init_worker).
+_STATE: dict[str, object] = {}
+
+
+def _init_worker(frame: pd.DataFrame, building: Building, settings: StudySettings) -> None:
+    _STATE["building"] = building
+    _STATE["settings"] = settings
+    _STATE["data"] = {m: _prepared(frame, building, m) for m in settings.models}
+
+
+def _prepared(frame: pd.DataFrame, building: Building, model: str) -> Dataset:
+    net = get_model(model, building, frame.columns)
+    return prepare(frame, building, net.compile().input_names, SignalOptions())
+
+
+def local_days(data: Dataset, timezone: str) -> pd.DatetimeIndex:
+    """Local midnights of the whole days in the record."""
+    local = data.times.tz_convert(timezone)
+    days = local.normalize().unique()
+    per_day = pd.Series(1, index=local.normalize()).groupby(level=0).size()
+    full = per_day[per_day >= round(86400 / data.step_s)].index
+    return days[days.isin(full)]
+
+
+def _window(
+    days: pd.DatetimeIndex, day: pd.Timestamp, count: int, period: str, before: bool
+) -> list[pd.Timestamp] | None:
+    """``count`` days before (or from) ``day`` in the period's calendar; None if not available."""
+    pool = days if period == "complete" else days[days.day_of_week < 5]
+    chosen = pool[pool < day][-count:] if before else pool[pool >= day][:count]
+    return list(chosen) if len(chosen) == count else None
+
+
+def _forecast_days(compiled, params: dict, data: Dataset, chosen: list[pd.Timestamp]) -> tuple:
+    """Predicted and measured t_in over ``chosen`` days; each run of consecutive days is one
+    forecast from the Kalman state at its start."""
+    runs, current = [], [chosen[0]]
+    for day in chosen[1:]:
+        if day - current[-1] == pd.Timedelta(days=1):
+            current.append(day)
+        else:
+            runs.append(current)
+            current = [day]
+    runs.append(current)
+    predicted, measured = [], []
+    for run in runs:
+        fc = forecast(compiled, params, data, run[0], hours=24 * len(run))
+        predicted.append(fc.t_in_pred)
+        measured.append(data.frame["t_in"].reindex(fc.times).to_numpy(dtype=float))
+    return np.concatenate(predicted), np.concatenate(measured)
+
+
+def run_task(task: Task) -> list[dict]:
+    """Every learning length for one (model, period, first predicted day)."""
+    settings: StudySettings = _STATE["settings"]  # type: ignore[assignment]
+    building: Building = _STATE["building"]  # type: ignore[assignment]
+    data: Dataset = _STATE["data"][task.model]  # type: ignore[index]
+    days = local_days(data, building.location.timezone)
+    net = get_model(task.model, building, data.frame.columns)
+    ahead = _window(days, task.day, max(settings.horizons), task.period, before=False)
+    out = []
+    for learn in settings.learn_days:
+        past = _window(days, task.day, learn, task.period, before=True)
+        if past is None or ahead is None:
+            continue
+        train = data.on_days(past)
+        started = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            est = Estimator(net, preset=settings.preset, random_state=settings.random_state)
+            est.fit(train)
+        wall = time.perf_counter() - started
+        predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead)
+        steps_per_day = round(86400 / data.step_s)
+        row = {
+            "model": task.model,
+            "period": task.period,
+            "day": task.day.date().isoformat(),
+            "weekday": task.day.day_name(),
+            "learn_days": learn,
+            "rmse_train": est.rmse_,
+            "wall_s": wall,
+            "n_simulations": est.n_simulations_,
+            **est.params_,
+        }
+        for h in settings.horizons:
+            row[f"rmse_h{h}"] = rmse(measured[: h * steps_per_day], predicted[: h * steps_per_day])
+        out.append(row)
+    return out
+
+
+def tasks_for(data: Dataset, building: Building, settings: StudySettings) -> list[Task]:
+    days = local_days(data, building.location.timezone)
+    first_possible = (
+        days[max(settings.learn_days)] if len(days) > max(settings.learn_days) else None
+    )
+    chosen = days[days >= first_possible] if first_possible is not None else days[:0]
+    if settings.start:
+        chosen = chosen[chosen >= pd.Timestamp(settings.start).tz_localize(days.tz)]
+    if settings.end:
+        chosen = chosen[chosen < pd.Timestamp(settings.end).tz_localize(days.tz)]
+    # Every horizon needs its days inside the record.
+    tasks = []
+    for period in settings.periods:
+        for day in chosen:
+            if period == "selected" and day.day_of_week >= 5:
+                continue
+            if _window(days, day, max(settings.horizons), period, before=False) is None:
+                continue
+            tasks.extend(Task(m, period, day) for m in settings.models)
+    return tasks
+
+
+def run_study(
+    frame: pd.DataFrame,
+    building: Building,
+    settings: StudySettings,
+    progress: Callable[[int, int], None] | None = None,
+) -> pd.DataFrame:
+    """Run every task (in parallel over days) and return one row per training."""
+    probe = _prepared(frame, building, settings.models[0])
+    tasks = tasks_for(probe, building, settings)
+    rows: list[dict] = []
+    done = 0
+    if settings.workers <= 1:
+        _init_worker(frame, building, settings)
+        for task in tasks:
+            rows.extend(run_task(task))
+            done += 1
+            if progress:
+                progress(done, len(tasks))
+    else:
+        with ProcessPoolExecutor(
+            settings.workers, initializer=_init_worker, initargs=(frame, building, settings)
+        ) as pool:
+            for result in pool.map(run_task, tasks, chunksize=2):
+                rows.extend(result)
+                done += 1
+                if progress:
+                    progress(done, len(tasks))
+    return pd.DataFrame(rows)
+
+
+def tables(results: pd.DataFrame, settings: StudySettings) -> dict[str, pd.DataFrame]:
+    """The thesis's three tables per model and period: parameters, training RMSE (one column per
+    learning length) and validation RMSE (learning length × horizon, 12 columns)."""
+    out = {"parameters": results}
+    for (model, period), group in results.groupby(["model", "period"]):
+        train = group.pivot(index="day", columns="learn_days", values="rmse_train")
+        train.columns = [f"learn_{c}d" for c in train.columns]
+        out[f"training_rmse_{model}_{period}"] = train
+        cols = {}
+        for learn in settings.learn_days:
+            sub = group[group.learn_days == learn].set_index("day")
+            for h in settings.horizons:
+                cols[f"learn_{learn}d_predict_{h}d"] = sub[f"rmse_h{h}"]
+        out[f"validation_rmse_{model}_{period}"] = pd.DataFrame(cols)
+    return out
+
+
+def summary(results: pd.DataFrame, settings: StudySettings) -> dict:
+    """Average RMSE per model, period, learning length and horizon; estimation wall times."""
+    avg: dict = {}
+    for (model, period, learn), group in results.groupby(["model", "period", "learn_days"]):
+        entry = avg.setdefault(model, {}).setdefault(period, {})
+        entry[f"learn_{learn}d"] = {
+            f"predict_{h}d": float(group[f"rmse_h{h}"].mean()) for h in settings.horizons
+        }
+        entry[f"learn_{learn}d"]["train"] = float(group["rmse_train"].mean())
+    wall = {
+        model: {
+            f"learn_{learn}d": float(g["wall_s"].mean()) for learn, g in group.groupby("learn_days")
+        }
+        for model, group in results.groupby("model")
+    }
+    long = results[results.learn_days >= 3]
+    headline = {
+        f"{model}_{period}": {
+            "rmse_1d_learn_ge_3d": float(g["rmse_h1"].mean()),
+            "rmse_7d_learn_ge_3d": float(g["rmse_h7"].mean()) if "rmse_h7" in g else None,
+        }
+        for (model, period), g in long.groupby(["model", "period"])
+    }
+    return {
+        "average_rmse": avg,
+        "headline": headline,
+        "estimation_wall_s": wall,
+        "trainings": len(results),
+    }
+
+
+def free_floating(
+    frame: pd.DataFrame,
+    building: Building,
+    model: str = "basic",
+    learn_days: int = 12,
+    predict_days: int = 12,
+    start: str = "2017-02-01",
+    preset: str = "default",
+) -> dict:
+    """Thesis §3.3: learn on the ``learn_days`` before ``start`` of a free-floating record and
+    predict ``predict_days``; RMSE, MBE, NMBE ("MBS"), CV(RMSE) and ASHRAE Guideline 14."""
+    data = _prepared(frame, building, model)
+    tz = building.location.timezone
+    day0 = pd.Timestamp(start).tz_localize(tz)
+    train = data.between(day0 - pd.Timedelta(days=learn_days), day0)
+    net = get_model(model, building, frame.columns)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        est = Estimator(net, preset=preset, random_state=0).fit(train)
+    fc = forecast(est.compiled, est.params_, data, day0, hours=24 * predict_days)
+    measured = data.frame["t_in"].reindex(fc.times).to_numpy(dtype=float)
+    metrics = evaluate(measured, fc.t_in_pred).to_dict()
+    return {
+        "model": model,
+        "learn_days": learn_days,
+        "predict_days": predict_days,
+        "start": day0.isoformat(),
+        "metrics": metrics,
+        "params": est.params_,
+        "times": fc.times,
+        "predicted": fc.t_in_pred,
+        "measured": measured,
+    }
