@@ -176,3 +176,49 @@ def diagnose(
             typer.echo(f"wrote {html_out}")
 
     _run(run)
+
+
+@app.command()
+def study(
+    data: DataArg,
+    building: BuildingOpt,
+    output: Annotated[Path, typer.Option("-o", "--output", help="folder for tables and figures")],
+    freefloat: Annotated[
+        Path | None, typer.Option(help="free-floating record for the §3.3 validation")
+    ] = None,
+    models: Annotated[str, typer.Option(help="comma-separated model names")] = "basic,sun",
+    start: Annotated[str | None, typer.Option(help="first predicted day (YYYY-MM-DD)")] = None,
+    end: Annotated[str | None, typer.Option(help="last predicted day, exclusive")] = None,
+    workers: Annotated[int, typer.Option(help="processes (0: every core)")] = 0,
+    preset: Annotated[str, typer.Option(help="estimator preset")] = "default",
+) -> None:
+    """The thesis's rolling learn/predict study: tables, summary.json and figures."""
+    import os
+
+    from tqdm import tqdm
+
+    from .study import StudySettings, run_study
+    from .study_report import write_study
+
+    def run() -> None:
+        b = Building.from_json(building)
+        frame = read_timeseries(data)
+        settings = StudySettings(
+            models=tuple(m.strip() for m in models.split(",") if m.strip()),
+            preset=preset,
+            start=start,
+            end=end,
+            workers=workers or os.cpu_count() or 1,
+        )
+        with tqdm(total=0, unit="day", desc="learn/predict") as bar:
+
+            def progress(done: int, total: int) -> None:
+                bar.total = total
+                bar.update(done - bar.n)
+
+            results = run_study(frame, b, settings, progress)
+        free = read_timeseries(freefloat) if freefloat else None
+        written = write_study(results, settings, frame, b, free, output)
+        typer.echo(f"{len(results)} trainings; wrote {len(written)} files to {output}")
+
+    _run(run)

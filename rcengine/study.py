@@ -88,9 +88,11 @@ def _window(
     return list(chosen) if len(chosen) == count else None
 
 
-def _forecast_days(compiled, params: dict, data: Dataset, chosen: list[pd.Timestamp]) -> tuple:
-    """Predicted and measured t_in over ``chosen`` days; each run of consecutive days is one
-    forecast from the Kalman state at its start."""
+def _forecast_days(
+    compiled, params: dict, data: Dataset, chosen: list[pd.Timestamp]
+) -> tuple[pd.DatetimeIndex, np.ndarray, np.ndarray]:
+    """Times, predicted and measured t_in over ``chosen`` days; each run of consecutive days is
+    one forecast from the Kalman state at its start."""
     runs, current = [], [chosen[0]]
     for day in chosen[1:]:
         if day - current[-1] == pd.Timedelta(days=1):
@@ -99,12 +101,40 @@ def _forecast_days(compiled, params: dict, data: Dataset, chosen: list[pd.Timest
             runs.append(current)
             current = [day]
     runs.append(current)
-    predicted, measured = [], []
+    times, predicted, measured = [], [], []
     for run in runs:
         fc = forecast(compiled, params, data, run[0], hours=24 * len(run))
+        times.append(fc.times)
         predicted.append(fc.t_in_pred)
         measured.append(data.frame["t_in"].reindex(fc.times).to_numpy(dtype=float))
-    return np.concatenate(predicted), np.concatenate(measured)
+    return times[0].append(times[1:]), np.concatenate(predicted), np.concatenate(measured)
+
+
+@dataclass(frozen=True)
+class Prediction:
+    estimator: Estimator
+    wall_s: float
+    times: pd.DatetimeIndex
+    predicted: np.ndarray
+    measured: np.ndarray
+
+
+def learn_and_predict(
+    data: Dataset,
+    network,
+    past: list[pd.Timestamp],
+    ahead: list[pd.Timestamp],
+    preset: str,
+    random_state: int,
+) -> Prediction:
+    """Fit on the ``past`` days, forecast the ``ahead`` days."""
+    started = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        est = Estimator(network, preset=preset, random_state=random_state).fit(data.on_days(past))
+    wall = time.perf_counter() - started
+    times, predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead)
+    return Prediction(est, wall, times, predicted, measured)
 
 
 def run_task(task: Task) -> list[dict]:
@@ -115,35 +145,51 @@ def run_task(task: Task) -> list[dict]:
     days = local_days(data, building.location.timezone)
     net = get_model(task.model, building, data.frame.columns)
     ahead = _window(days, task.day, max(settings.horizons), task.period, before=False)
+    steps_per_day = round(86400 / data.step_s)
     out = []
     for learn in settings.learn_days:
         past = _window(days, task.day, learn, task.period, before=True)
         if past is None or ahead is None:
             continue
-        train = data.on_days(past)
-        started = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ConvergenceWarning)
-            est = Estimator(net, preset=settings.preset, random_state=settings.random_state)
-            est.fit(train)
-        wall = time.perf_counter() - started
-        predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead)
-        steps_per_day = round(86400 / data.step_s)
+        p = learn_and_predict(data, net, past, ahead, settings.preset, settings.random_state)
         row = {
             "model": task.model,
             "period": task.period,
             "day": task.day.date().isoformat(),
             "weekday": task.day.day_name(),
             "learn_days": learn,
-            "rmse_train": est.rmse_,
-            "wall_s": wall,
-            "n_simulations": est.n_simulations_,
-            **est.params_,
+            "rmse_train": p.estimator.rmse_,
+            "wall_s": p.wall_s,
+            "n_simulations": p.estimator.n_simulations_,
+            **p.estimator.params_,
         }
         for h in settings.horizons:
-            row[f"rmse_h{h}"] = rmse(measured[: h * steps_per_day], predicted[: h * steps_per_day])
+            n = h * steps_per_day
+            row[f"rmse_h{h}"] = rmse(p.measured[:n], p.predicted[:n])
         out.append(row)
     return out
+
+
+def example(
+    frame: pd.DataFrame,
+    building: Building,
+    model: str,
+    day: str,
+    learn_days: int,
+    horizon_days: int,
+    period: str = "complete",
+    preset: str = "default",
+) -> Prediction:
+    """One learn/predict pair for the example figures (thesis Fig. 3.1–3.3)."""
+    data = _prepared(frame, building, model)
+    days = local_days(data, building.location.timezone)
+    start = pd.Timestamp(day).tz_localize(building.location.timezone)
+    past = _window(days, start, learn_days, period, before=True)
+    ahead = _window(days, start, horizon_days, period, before=False)
+    if past is None or ahead is None:
+        raise ValueError(f"{day}: not enough days around it for {learn_days}+{horizon_days} days")
+    net = get_model(model, building, frame.columns)
+    return learn_and_predict(data, net, past, ahead, preset, 0)
 
 
 def tasks_for(data: Dataset, building: Building, settings: StudySettings) -> list[Task]:
