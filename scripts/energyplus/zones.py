@@ -1,0 +1,199 @@
+"""Zone-level IDF objects: the zone, its gains, air exchange and ideal-loads heating."""
+
+from __future__ import annotations
+
+from .idf import constant_schedule, idf_object
+
+# Sensible + latent heat of a seated office worker, as thesis §2.4.1. [W/person]
+ACTIVITY_W = 100.0
+
+
+def zone(name: str) -> str:
+    """A zone whose volume, ceiling height and floor area EnergyPlus takes from its surfaces."""
+    return idf_object("Zone", name, 0.0, 0.0, 0.0, 0.0, 1, 1, "autocalculate", "autocalculate")
+
+
+def people(zone_name: str, count: float, schedule: str, activity_schedule: str) -> str:
+    """Occupants; EnergyPlus splits the activity into sensible and latent by air temperature."""
+    return idf_object(
+        "People",
+        f"{zone_name} People",
+        zone_name,
+        schedule,
+        "People",
+        count,
+        None,
+        None,
+        0.3,
+        "autocalculate",
+        activity_schedule,
+    )
+
+
+def activity_schedule(name: str = "Activity") -> str:
+    return constant_schedule(name, ACTIVITY_W)
+
+
+def lights(zone_name: str, watts_per_m2: float, schedule: str) -> str:
+    """Lighting; radiant / visible fractions of suspended fluorescent luminaires
+    (EnergyPlus Input Output Reference, Lights, table of heat gain fractions)."""
+    return idf_object(
+        "Lights",
+        f"{zone_name} Lights",
+        zone_name,
+        schedule,
+        "Watts/Area",
+        None,
+        watts_per_m2,
+        None,
+        0.0,
+        0.42,
+        0.18,
+        1.0,
+        "General",
+    )
+
+
+def electric_equipment(zone_name: str, watts_per_m2: float, schedule: str) -> str:
+    """Plug loads (office equipment): half radiant."""
+    return idf_object(
+        "ElectricEquipment",
+        f"{zone_name} Equipment",
+        zone_name,
+        schedule,
+        "Watts/Area",
+        None,
+        watts_per_m2,
+        None,
+        0.0,
+        0.5,
+        0.0,
+        "General",
+    )
+
+
+def infiltration(
+    zone_name: str,
+    ach: float,
+    constant: float = 1.0,
+    per_wind: float = 0.0,
+    schedule: str = "AlwaysOn",
+) -> str:
+    """Infiltration ``ach · (constant + per_wind · v_wind)``; v_wind is EnergyPlus's local
+    wind speed at the zone centroid height. [1/h], [-], [s/m]"""
+    return idf_object(
+        "ZoneInfiltration:DesignFlowRate",
+        f"{zone_name} Infiltration",
+        zone_name,
+        schedule,
+        "AirChanges/Hour",
+        None,
+        None,
+        None,
+        ach,
+        constant,
+        0.0,
+        per_wind,
+        0.0,
+    )
+
+
+def ventilation(zone_name: str, ach: float, schedule: str) -> str:
+    """Outdoor-air ventilation (balanced, no fan heat) at ``ach`` while ``schedule`` is on. [1/h]"""
+    return idf_object(
+        "ZoneVentilation:DesignFlowRate",
+        f"{zone_name} Ventilation",
+        zone_name,
+        schedule,
+        "AirChanges/Hour",
+        None,
+        None,
+        None,
+        ach,
+        "Balanced",
+        0.0,
+        1.0,
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+    )
+
+
+def internal_mass(zone_name: str, construction: str, area: float, tag: str = "Mass") -> str:
+    """Exposed internal mass of ``area`` (one face; the other face is adiabatic). [m²]"""
+    return idf_object("InternalMass", f"{zone_name} {tag}", construction, zone_name, None, area)
+
+
+def ideal_loads_heating(
+    zone_name: str, setpoint_schedule: str, availability_schedule: str, capacity_w: float
+) -> str:
+    """Heating-only ideal loads air system, limited to ``capacity_w`` of sensible heat. [W]
+
+    A single-heating thermostat, so no cooling is ever asked for; when ``availability_schedule``
+    is 0 the zone floats freely.
+    """
+    z = zone_name
+    return "".join(
+        [
+            idf_object(
+                "ZoneHVAC:EquipmentConnections",
+                z,
+                f"{z} Equipment",
+                f"{z} Supply Inlet",
+                None,
+                f"{z} Air Node",
+                f"{z} Return Outlet",
+            ),
+            idf_object(
+                "ZoneHVAC:EquipmentList",
+                f"{z} Equipment",
+                "SequentialLoad",
+                "ZoneHVAC:IdealLoadsAirSystem",
+                f"{z} Ideal Loads",
+                1,
+                1,
+                None,
+                None,
+            ),
+            idf_object(
+                "ZoneHVAC:IdealLoadsAirSystem",
+                f"{z} Ideal Loads",
+                availability_schedule,
+                f"{z} Supply Inlet",
+                None,
+                None,
+                50.0,
+                13.0,
+                0.0156,
+                0.0077,
+                "LimitCapacity",
+                None,
+                capacity_w,
+                "NoLimit",
+                None,
+                None,
+                None,
+                "AlwaysOff",
+                "None",
+                0.7,
+                "None",
+            ),
+            idf_object(
+                "ZoneControl:Thermostat",
+                f"{z} Thermostat",
+                z,
+                "SingleHeatingControl",
+                "ThermostatSetpoint:SingleHeating",
+                f"{z} Heating Setpoint",
+            ),
+            idf_object(
+                "ThermostatSetpoint:SingleHeating", f"{z} Heating Setpoint", setpoint_schedule
+            ),
+        ]
+    )
+
+
+def single_heating_control_schedule() -> str:
+    """Control-type schedule of ``ZoneControl:Thermostat``: 1 = single heating setpoint."""
+    return constant_schedule("SingleHeatingControl", 1)

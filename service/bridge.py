@@ -1,0 +1,149 @@
+"""The one bridge between stored rows and engine objects, for routers, jobs and CLI alike.
+
+- measurement rows ↔ the engine's frame (UTC ``DatetimeIndex`` named ``time``, float columns of
+  the contract, NaN for missing values);
+- building rows → :class:`~rcengine.building.Building`;
+- parameter-set rows ↔ :class:`~rcengine.params.ParameterSet` (the stored document is exactly
+  the ``params.json`` that ``rcengine predict`` reads).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Sequence
+from datetime import datetime
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from sqlalchemy import Row
+from sqlalchemy.orm import Session
+
+from rcengine.building import Building
+from rcengine.columns import COLUMNS, NUMERIC_COLUMNS, TIME
+from rcengine.exceptions import DataValidationError, Problem
+from rcengine.io.timeseries import format_times
+from rcengine.params import ParameterSet
+
+from . import repository
+from .models import ParameterSetRecord
+
+# "2017-01-09T06:15:00 01:00": a '+' sent unescaped in a query string arrives as a space.
+_PLUS_AS_SPACE = re.compile(r"^(\S+T\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?) (\d{2}:?\d{2})$")
+
+
+# --- times ------------------------------------------------------------------------------------
+def parse_instant(text: str, name: str) -> pd.Timestamp:
+    """An ISO 8601 time with a UTC offset, as a UTC timestamp.
+
+    Raises
+    ------
+    DataValidationError : naming ``name`` when the text is not such a time.
+    """
+    text = _PLUS_AS_SPACE.sub(r"\1+\2", text.strip())
+    try:
+        stamp = pd.Timestamp(text)
+    except ValueError:
+        stamp = None
+    if stamp is None or pd.isna(stamp) or stamp.tzinfo is None:
+        raise DataValidationError(
+            [
+                Problem(
+                    None,
+                    name,
+                    f"{name} {text!r} is not an ISO 8601 time with a UTC offset, e.g. "
+                    "2017-01-09T06:15:00+01:00 (write '+' as %2B in a URL)",
+                )
+            ]
+        )
+    return stamp.tz_convert("UTC")
+
+
+def to_datetime(stamp: pd.Timestamp) -> datetime:
+    return stamp.tz_convert("UTC").to_pydatetime()
+
+
+def local_time(value: datetime | pd.Timestamp | None, timezone: str) -> str | None:
+    """One time as ISO 8601 with the offset of ``timezone`` (None stays None)."""
+    if value is None:
+        return None
+    return format_times(pd.DatetimeIndex([pd.Timestamp(value)]), timezone)[0]
+
+
+# --- measurements -----------------------------------------------------------------------------
+def frame_to_rows(frame: pd.DataFrame) -> list[dict[str, Any]]:
+    """Rows for the upsert: ``time`` as a UTC datetime, values as floats or None."""
+    values = frame.to_numpy(dtype=float)
+    cells = values.astype(object)
+    cells[np.isnan(values)] = None
+    keys = (TIME, *frame.columns)
+    times = frame.index.tz_convert("UTC").to_pydatetime()
+    return [
+        dict(zip(keys, (t, *row), strict=True))
+        for t, row in zip(times, cells.tolist(), strict=True)
+    ]
+
+
+def rows_to_frame(rows: Sequence[Row], columns: Sequence[str]) -> pd.DataFrame:
+    """The engine's frame from ``(time, *columns)`` rows; an optional column with no value in
+    any row is left out (absent physics, as the validator treats it)."""
+    index = pd.DatetimeIndex([r[0] for r in rows], name=TIME, tz="UTC")
+    values = np.array([r[1:] for r in rows], dtype=float).reshape(len(rows), len(columns))
+    frame = pd.DataFrame(values, index=index, columns=list(columns))
+    empty = [c for c in columns if not COLUMNS[c].required and not frame[c].notna().any()]
+    return frame.drop(columns=empty)
+
+
+def load_frame(
+    session: Session,
+    building_id: int,
+    start: pd.Timestamp | None = None,
+    end: pd.Timestamp | None = None,
+) -> pd.DataFrame:
+    """Stored rows of a building with start ≤ time < end as the engine's frame."""
+    rows = repository.read_measurements(
+        session,
+        building_id,
+        NUMERIC_COLUMNS,
+        None if start is None else to_datetime(start),
+        None if end is None else to_datetime(end),
+    )
+    return rows_to_frame(rows, NUMERIC_COLUMNS)
+
+
+# --- buildings and parameter sets -------------------------------------------------------------
+def building_of(description: dict[str, Any]) -> Building:
+    return Building.from_dict(description)
+
+
+def parameter_set_of(record: ParameterSetRecord) -> ParameterSet:
+    return ParameterSet.from_dict(record.document)
+
+
+def parameter_set_record(
+    pset: ParameterSet, building_id: int, job_id: int | None, reason: str | None
+) -> ParameterSetRecord:
+    """A row holding ``pset`` (status and ``is_current`` are set when it is stored)."""
+    document = json.loads(json.dumps(pset.to_dict(), default=_plain))
+    holdout = pset.metrics.get("holdout") or {}
+    return ParameterSetRecord(
+        building_id=building_id,
+        job_id=job_id,
+        model=pset.model,
+        reason=reason,
+        train_start=to_datetime(pd.Timestamp(pset.fit["start"])),
+        train_end=to_datetime(pd.Timestamp(pset.fit["end"])),
+        rmse_train=pset.metrics["train"]["rmse"],
+        rmse_holdout=holdout.get("rmse"),
+        metrics=document["metrics"],
+        engine_version=pset.engine_version,
+        document=document,
+    )
+
+
+def _plain(value: object) -> object:
+    """numpy scalars and arrays inside a parameter-set document, as JSON values."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

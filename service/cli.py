@@ -1,0 +1,102 @@
+"""Command line: ``rcservice serve | retrain-all | reset-admin-token``.
+
+Heavy imports stay inside the commands: calibration worker processes (spawned) import this
+module as their ``__main__`` when the server was started through it.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+app = typer.Typer(
+    help="The rcengine calibration service (FastAPI).",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+
+
+def _settings():
+    from pydantic import ValidationError
+
+    from .core.config import Settings
+    from .core.logging import configure_logging
+
+    try:
+        settings = Settings()
+    except ValidationError as exc:
+        typer.secho(f"error: invalid RCSERVICE_* setting:\n{exc}", fg=typer.colors.RED, err=True)
+        raise typer.Exit(code=2) from None
+    configure_logging(settings.log_level)
+    return settings
+
+
+@app.command()
+def serve(
+    host: Annotated[str, typer.Option(help="interface to listen on")] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="TCP port")] = 8000,
+) -> None:
+    """Run the HTTP service (uvicorn) until Ctrl-C."""
+    import uvicorn
+
+    from .main import create_app
+
+    settings = _settings()
+    shown = "localhost" if host in ("0.0.0.0", "::") else host
+    typer.echo(f"rcservice: API docs at http://{shown}:{port}/docs (OpenAPI: /openapi.json)")
+    if settings.admin_token is not None:
+        typer.echo("rcservice: admin token = the value of RCSERVICE_ADMIN_TOKEN")
+    else:
+        typer.echo(
+            f"rcservice: admin token printed at first start and kept in {settings.token_file()} "
+            "(mode 0600); `rcservice reset-admin-token` makes a new one"
+        )
+    uvicorn.run(create_app(settings), host=host, port=port, log_config=None, access_log=False)
+
+
+@app.command("retrain-all")
+def retrain_all() -> None:
+    """Calibrate every building with new data since its last job, once (for an external cron).
+
+    Exits with 1 if any job failed.
+    """
+    from .core.db import Database
+    from .jobs import retrain_all_inline
+    from .models import FAILED
+
+    settings = _settings()
+    db = Database(settings.database_url)
+    try:
+        db.migrate()
+        results = retrain_all_inline(db, settings, trigger="cli")
+    finally:
+        db.dispose()
+    for job_id, status in results.items():
+        typer.echo(f"job {job_id}: {status}")
+    typer.echo(f"{len(results)} job(s) run")
+    if FAILED in results.values():
+        raise typer.Exit(code=1)
+
+
+@app.command("reset-admin-token")
+def reset_admin_token() -> None:
+    """Replace the generated admin token; prints the new one (the old one stops working)."""
+    from .core.db import Database
+    from .core.security import reset_admin_token as reset
+
+    settings = _settings()
+    if settings.admin_token is not None:
+        typer.echo("RCSERVICE_ADMIN_TOKEN is set: that value is the admin token; change it there")
+        raise typer.Exit(code=2)
+    db = Database(settings.database_url)
+    try:
+        db.migrate()
+        token, path = reset(settings, db)
+    finally:
+        db.dispose()
+    typer.echo(f"new admin token {token}\n  (also written to {path}); restart the server")
+
+
+if __name__ == "__main__":
+    app()

@@ -1,0 +1,1 @@
+"""Shared pieces of the service: settings, database, security, logging."""

@@ -1,0 +1,116 @@
+"""Service settings from the environment (prefix ``RCSERVICE_``), checked once at start-up."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+
+from pydantic import Field, SecretStr, field_validator
+from pydantic_settings import BaseSettings, SettingsConfigDict
+from sqlalchemy.engine import make_url
+
+from rcengine.estimate import PRESETS
+from rcengine.models import MODELS
+
+# A shorter admin token is guessable; generated tokens have 43 characters.
+MIN_ADMIN_TOKEN_CHARS = 24
+ADMIN_TOKEN_FILE_NAME = "rcservice-admin-token"
+
+
+class Settings(BaseSettings):
+    """Everything the service reads from its environment.
+
+    Each field ``name`` is set by the variable ``RCSERVICE_NAME`` (e.g. ``RCSERVICE_WORKERS=2``).
+    """
+
+    model_config = SettingsConfigDict(env_prefix="RCSERVICE_", env_file=None, extra="ignore")
+
+    database_url: str = Field(
+        "sqlite:///./rcservice.db",
+        description="SQLAlchemy URL: SQLite file (default) or postgresql+psycopg://...",
+    )
+    admin_token: SecretStr | None = Field(
+        None,
+        description="Token that may register buildings. Unset: one is generated at first start, "
+        "stored hashed and written once to admin_token_file.",
+    )
+    admin_token_file: Path | None = Field(
+        None,
+        description="Where a generated admin token is written (mode 0600). Default: next to "
+        "the SQLite file, or the working directory for other databases.",
+    )
+    retrain_hour: int = Field(2, ge=0, le=23, description="Local hour of the nightly re-fit.")
+    timezone: str = Field("UTC", description="Time zone of retrain_hour (IANA name).")
+    scheduler_enabled: bool = True
+    training_days: int = Field(7, ge=1, le=365, description="Days fitted by default.")
+    model: str = Field("basic", description="Default model of the rcengine library.")
+    preset: str = Field("default", description="Estimator preset of rcengine.estimate.")
+    random_state: int = 0
+    max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="Request size limit.")
+    workers: int = Field(
+        1,
+        ge=0,
+        le=64,
+        description="Calibration worker processes; 0 runs calibrations on a thread of the "
+        "server process (tests, tiny deployments).",
+    )
+    forecast_cache_size: int = Field(512, ge=0, description="Forecasts kept in memory.")
+    log_level: str = "INFO"
+
+    @field_validator("timezone")
+    @classmethod
+    def _known_timezone(cls, value: str) -> str:
+        try:
+            ZoneInfo(value)
+        except (ZoneInfoNotFoundError, ValueError) as exc:
+            raise ValueError(f"unknown time zone {value!r}") from exc
+        return value
+
+    @field_validator("model")
+    @classmethod
+    def _known_model(cls, value: str) -> str:
+        if value not in MODELS:
+            raise ValueError(f"invalid model {value!r}; choose from {sorted(MODELS)}")
+        return value
+
+    @field_validator("preset")
+    @classmethod
+    def _known_preset(cls, value: str) -> str:
+        if value not in PRESETS:
+            raise ValueError(f"invalid preset {value!r}; choose from {sorted(PRESETS)}")
+        return value
+
+    @field_validator("admin_token")
+    @classmethod
+    def _long_enough(cls, value: SecretStr | None) -> SecretStr | None:
+        if value is not None and len(value.get_secret_value()) < MIN_ADMIN_TOKEN_CHARS:
+            raise ValueError(
+                f"admin token must have at least {MIN_ADMIN_TOKEN_CHARS} characters; "
+                "unset it to have one generated"
+            )
+        return value
+
+    @field_validator("database_url")
+    @classmethod
+    def _parsable_url(cls, value: str) -> str:
+        make_url(value)  # raises ArgumentError on a malformed URL
+        return value
+
+    @property
+    def is_sqlite(self) -> bool:
+        return make_url(self.database_url).get_backend_name() == "sqlite"
+
+    @property
+    def sqlite_path(self) -> Path | None:
+        """The database file, or None for an in-memory or non-SQLite database."""
+        url = make_url(self.database_url)
+        if url.get_backend_name() != "sqlite" or url.database in (None, "", ":memory:"):
+            return None
+        return Path(url.database)
+
+    def token_file(self) -> Path:
+        if self.admin_token_file is not None:
+            return self.admin_token_file
+        db_file = self.sqlite_path
+        folder = db_file.parent if db_file is not None else Path.cwd()
+        return folder / ADMIN_TOKEN_FILE_NAME

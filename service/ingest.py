@@ -1,0 +1,136 @@
+"""Uploads of measurements: parse a body, validate it whole, store it in one transaction.
+
+Validation is the engine's (:mod:`rcengine.io.timeseries`), so the service rejects exactly what
+``rcengine`` rejects. One rule only the service can check: rows must lie on the time grid of the
+rows already stored (same step, same phase), or the stored series would have mixed steps.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from rcengine.columns import T_IN, TIME
+from rcengine.dataset import Dataset
+from rcengine.exceptions import DataValidationError, Problem
+from rcengine.io.timeseries import FIRST_DATA_LINE, parse_rows, read_timeseries
+
+from . import bridge, repository
+from .core.db import Database
+from .models import BuildingRecord
+
+_NS_PER_S = 1_000_000_000
+
+
+@dataclass(frozen=True)
+class Upload:
+    """A validated upload: the engine's frame, and the file line of row 0 for CSV bodies."""
+
+    frame: pd.DataFrame
+    first_line: int | None = None
+
+
+@dataclass(frozen=True)
+class UploadResult:
+    inserted: int
+    updated: int
+    rows: int
+    first_time: pd.Timestamp
+    last_time: pd.Timestamp
+    data_revision: int
+
+
+def from_json(body: bytes) -> Upload:
+    """``{"rows": [{"time": ..., "t_in": ...}, ...]}``; problems name the index in ``rows``."""
+    try:
+        document = json.loads(body)
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        where = f" at line {exc.lineno} column {exc.colno}" if hasattr(exc, "lineno") else ""
+        raise DataValidationError(
+            [Problem(None, None, f"the body is not valid JSON{where}: {_reason(exc)}")]
+        ) from None
+    if not isinstance(document, dict) or "rows" not in document:
+        raise DataValidationError(
+            [Problem(None, None, 'the JSON body must be an object {"rows": [...]}')]
+        )
+    return Upload(parse_rows(document["rows"]))
+
+
+def from_csv(body: bytes) -> Upload:
+    """CSV of CONTRACT.md §1; problems name the row and the line of the body."""
+    try:
+        text = body.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataValidationError([Problem(None, None, f"the CSV is not UTF-8: {exc}")]) from None
+    return Upload(read_timeseries(io.StringIO(text)), FIRST_DATA_LINE)
+
+
+def store(db: Database, building_id: int, upload: Upload) -> UploadResult:
+    """Upsert the rows by time in one transaction; nothing is written if a check fails."""
+    frame = upload.frame
+    rows = bridge.frame_to_rows(frame)
+    first, last = frame.index[0], frame.index[-1]
+    with db.write() as session:
+        building = repository.get_building(session, building_id)
+        _check_grid(building, frame, upload.first_line)
+        existing = repository.existing_times(
+            session, building_id, bridge.to_datetime(first), bridge.to_datetime(last)
+        )
+        updated = len(existing.intersection(r[TIME] for r in rows))
+        repository.upsert_measurements(session, building_id, list(frame.columns), rows)
+        _remember(building, frame)
+        building.data_revision += 1
+        revision = building.data_revision
+    return UploadResult(len(rows) - updated, updated, len(rows), first, last, revision)
+
+
+def _upload_step_s(frame: pd.DataFrame) -> float | None:
+    return Dataset.from_frame(frame).step_s if len(frame) >= 2 else None
+
+
+def _check_grid(building: BuildingRecord, frame: pd.DataFrame, first_line: int | None) -> None:
+    """Every time must be the stored grid origin plus a whole number of stored steps."""
+    step_s = building.step_s or _upload_step_s(frame)
+    if building.grid_origin is None or step_s is None:
+        return
+    origin_ns = pd.Timestamp(building.grid_origin).as_unit("ns").value
+    offsets = frame.index.as_unit("ns").asi8 - origin_ns
+    off_grid = np.flatnonzero(offsets % round(step_s * _NS_PER_S) != 0)
+    if not off_grid.size:
+        return
+    grid = bridge.local_time(building.grid_origin, building.timezone)
+    line = "" if first_line is None else " — line {} of the file"
+    raise DataValidationError(
+        [
+            Problem(
+                int(row),
+                TIME,
+                f"time {bridge.local_time(frame.index[row], building.timezone)} is not on the "
+                f"{step_s:g}-s grid of the rows already stored (e.g. {grid}); "
+                "the step of a building's series cannot change (mixed steps)"
+                + line.format(row + (first_line or 0)),
+            )
+            for row in off_grid[:100]
+        ]
+    )
+
+
+def _remember(building: BuildingRecord, frame: pd.DataFrame) -> None:
+    """Grid of the series (first upload) and the latest measured time."""
+    measured = frame.index[frame[T_IN].notna().to_numpy()]
+    if len(measured):
+        latest = bridge.to_datetime(measured[-1])
+        if building.last_measured_at is None or latest > building.last_measured_at:
+            building.last_measured_at = latest
+    if building.grid_origin is None:
+        building.grid_origin = bridge.to_datetime(frame.index[0])
+    if building.step_s is None:
+        building.step_s = _upload_step_s(frame)
+
+
+def _reason(exc: Exception) -> str:
+    return getattr(exc, "msg", None) or str(exc)

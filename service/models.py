@@ -1,0 +1,177 @@
+"""Database tables (SQLAlchemy 2). Alembic owns the schema: a change here needs a migration.
+
+Measurements are one row per (building, time) with the contract columns of
+:mod:`rcengine.columns`, clustered on that key so that a forecast reads one short range.
+Times are stored in UTC (:class:`UTCDateTime`), whatever the database.
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from typing import Any, ClassVar
+
+from sqlalchemy import (
+    JSON,
+    Column,
+    DateTime,
+    Float,
+    ForeignKey,
+    Index,
+    Integer,
+    String,
+    Table,
+    Text,
+    text,
+)
+from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+from sqlalchemy.types import TypeDecorator
+
+from rcengine.columns import NUMERIC_COLUMNS, TIME
+
+# Job life cycle (CONTRACT.md §4) and what a finished calibration did with its result.
+QUEUED, RUNNING, SUCCEEDED, FAILED = "queued", "running", "succeeded", "failed"
+ACTIVE_JOB_STATUSES = (QUEUED, RUNNING)
+PROMOTED, REJECTED = "promoted", "rejected"
+# Parameter-set status: the one in use, one it replaced, or one that lost on the held-out day.
+CURRENT, SUPERSEDED = "current", "superseded"
+
+
+def utc_now() -> datetime:
+    return datetime.now(UTC)
+
+
+class UTCDateTime(TypeDecorator):
+    """Timezone-aware datetimes in, UTC datetimes out, on SQLite (naive text) and PostgreSQL."""
+
+    impl = DateTime(timezone=True)
+    cache_ok = True
+
+    def process_bind_param(self, value: datetime | None, dialect: Any) -> datetime | None:
+        if value is None:
+            return None
+        if value.tzinfo is None:
+            raise ValueError(f"naive datetime {value!r}: the service stores UTC instants only")
+        return value.astimezone(UTC)
+
+    def process_result_value(self, value: datetime | None, dialect: Any) -> datetime | None:
+        if value is None:
+            return None
+        return value.replace(tzinfo=UTC) if value.tzinfo is None else value.astimezone(UTC)
+
+
+class Base(DeclarativeBase):
+    type_annotation_map: ClassVar[dict[Any, Any]] = {
+        datetime: UTCDateTime,
+        float: Float,
+        dict[str, Any]: JSON,
+    }
+
+
+class BuildingRecord(Base):
+    """A registered building: its §2 description, token hash and time grid."""
+
+    __tablename__ = "buildings"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(200))
+    description: Mapped[dict[str, Any]]
+    timezone: Mapped[str] = mapped_column(String(64))
+    token_hash: Mapped[str] = mapped_column(String(64), unique=True)
+    # Step and one time of the stored series: later uploads must lie on the same grid. [s]
+    step_s: Mapped[float | None]
+    grid_origin: Mapped[datetime | None]
+    # Latest time with a measured t_in: a forecast starts one step after it by default.
+    last_measured_at: Mapped[datetime | None]
+    # Incremented by every upload; forecasts are cached per revision, jobs record the one fitted.
+    data_revision: Mapped[int] = mapped_column(Integer, default=0)
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+
+measurements = Table(
+    "measurements",
+    Base.metadata,
+    Column(
+        "building_id",
+        Integer,
+        ForeignKey("buildings.id", ondelete="CASCADE"),
+        primary_key=True,
+    ),
+    Column(TIME, UTCDateTime, primary_key=True),
+    *(Column(name, Float, nullable=True) for name in NUMERIC_COLUMNS),
+    sqlite_with_rowid=False,
+)
+
+
+class JobRecord(Base):
+    """A calibration: queued → running → succeeded | failed; ``outcome`` says promoted or not."""
+
+    __tablename__ = "jobs"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
+    status: Mapped[str] = mapped_column(String(16), default=QUEUED)
+    outcome: Mapped[str | None] = mapped_column(String(16))
+    trigger: Mapped[str] = mapped_column(String(16))
+    model: Mapped[str] = mapped_column(String(100))
+    days: Mapped[int] = mapped_column(Integer)
+    data_revision: Mapped[int] = mapped_column(Integer)
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+    started_at: Mapped[datetime | None]
+    finished_at: Mapped[datetime | None]
+    error: Mapped[str | None] = mapped_column(Text)
+    details: Mapped[dict[str, Any] | None] = mapped_column(JSON)
+
+    __table_args__ = (
+        # At most one queued or running job per building, enforced by the database.
+        Index(
+            "uq_jobs_active_building",
+            "building_id",
+            unique=True,
+            sqlite_where=text("status IN ('queued', 'running')"),
+            postgresql_where=text("status IN ('queued', 'running')"),
+        ),
+        Index("ix_jobs_building_created", "building_id", "created_at"),
+    )
+
+
+class ParameterSetRecord(Base):
+    """A fitted parameter set: the full ``params.json`` document plus searchable summaries."""
+
+    __tablename__ = "parameter_sets"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
+    job_id: Mapped[int | None] = mapped_column(ForeignKey("jobs.id", ondelete="SET NULL"))
+    model: Mapped[str] = mapped_column(String(100))
+    status: Mapped[str] = mapped_column(String(16))
+    is_current: Mapped[bool] = mapped_column(default=False)
+    reason: Mapped[str | None] = mapped_column(Text)
+    train_start: Mapped[datetime]
+    train_end: Mapped[datetime]
+    rmse_train: Mapped[float | None]
+    rmse_holdout: Mapped[float | None]
+    metrics: Mapped[dict[str, Any]]
+    engine_version: Mapped[str] = mapped_column(String(32))
+    document: Mapped[dict[str, Any]]
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+    __table_args__ = (
+        Index(
+            "uq_parameter_sets_current_building",
+            "building_id",
+            unique=True,
+            sqlite_where=text("is_current"),
+            postgresql_where=text("is_current"),
+        ),
+        Index("ix_parameter_sets_building_created", "building_id", "created_at"),
+    )
+
+
+class AdminTokenRecord(Base):
+    """Hash of the generated admin token (one row); unused when RCSERVICE_ADMIN_TOKEN is set."""
+
+    __tablename__ = "admin_tokens"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    token_hash: Mapped[str] = mapped_column(String(64))
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)

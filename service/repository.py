@@ -1,0 +1,320 @@
+"""Every database query of the service, on a caller's session (SQLite and PostgreSQL alike).
+
+Functions take a :class:`~sqlalchemy.orm.Session` and neither commit nor open transactions:
+callers choose ``Database.session()`` (reads) or ``Database.write()`` (one write transaction);
+the Core-only query of the forecast hot path also runs on ``Database.connect()``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from datetime import datetime
+from typing import Any
+
+from sqlalchemy import Connection, Insert, Row, and_, func, select, update
+from sqlalchemy.dialects import postgresql, sqlite
+from sqlalchemy.exc import IntegrityError
+from sqlalchemy.orm import Session
+
+from rcengine.columns import TIME
+
+from .errors import ConflictError, NotFoundError
+from .models import (
+    ACTIVE_JOB_STATUSES,
+    CURRENT,
+    FAILED,
+    QUEUED,
+    REJECTED,
+    RUNNING,
+    SUPERSEDED,
+    AdminTokenRecord,
+    BuildingRecord,
+    JobRecord,
+    ParameterSetRecord,
+    measurements,
+    utc_now,
+)
+
+_INSERT = {"sqlite": sqlite.insert, "postgresql": postgresql.insert}
+
+
+# --- buildings --------------------------------------------------------------------------------
+def add_building(
+    session: Session, name: str, description: dict[str, Any], timezone: str, token_hash: str
+) -> BuildingRecord:
+    record = BuildingRecord(
+        name=name,
+        description=description,
+        timezone=timezone,
+        token_hash=token_hash,
+        data_revision=0,
+    )
+    session.add(record)
+    session.flush()
+    return record
+
+
+def get_building(session: Session, building_id: int) -> BuildingRecord:
+    record = session.get(BuildingRecord, building_id)
+    if record is None:
+        raise NotFoundError(f"building {building_id} not found")
+    return record
+
+
+def list_buildings(session: Session) -> Sequence[BuildingRecord]:
+    return session.scalars(select(BuildingRecord).order_by(BuildingRecord.id)).all()
+
+
+def building_id_for_token(session: Session, token_hash: str) -> int | None:
+    return session.scalar(select(BuildingRecord.id).where(BuildingRecord.token_hash == token_hash))
+
+
+def set_token_hash(session: Session, building_id: int, token_hash: str) -> None:
+    get_building(session, building_id).token_hash = token_hash
+
+
+# --- measurements -----------------------------------------------------------------------------
+def existing_times(
+    session: Session, building_id: int, start: datetime, end: datetime
+) -> set[datetime]:
+    """Stored times of a building in [start, end]."""
+    time = measurements.c[TIME]
+    query = select(time).where(
+        measurements.c.building_id == building_id, time >= start, time <= end
+    )
+    return set(session.scalars(query))
+
+
+def upsert_measurements(
+    session: Session, building_id: int, columns: Sequence[str], rows: list[dict[str, Any]]
+) -> None:
+    """Insert rows, or update the stored row at the same time (see :func:`upsert_statement`)."""
+    statement = upsert_statement(session.get_bind().dialect.name, columns)
+    # A list of parameters runs as the driver's executemany: one statement compiled, rows bound
+    # in C (a multi-row VALUES clause would compile one bound parameter per cell).
+    session.execute(statement, [{"building_id": building_id, **row} for row in rows])
+
+
+def upsert_statement(dialect: str, columns: Sequence[str]) -> Insert:
+    """``INSERT … ON CONFLICT (building_id, time) DO UPDATE`` writing only ``columns``; on
+    update an empty value (NULL) keeps the stored one, so a re-uploaded forecast row never
+    erases a measured ``t_in``."""
+    statement = _INSERT[dialect](measurements)
+    return statement.on_conflict_do_update(
+        index_elements=["building_id", TIME],
+        set_={c: func.coalesce(statement.excluded[c], measurements.c[c]) for c in columns},
+    )
+
+
+def read_measurements(
+    session: Session,
+    building_id: int,
+    columns: Sequence[str],
+    start: datetime | None = None,
+    end: datetime | None = None,
+) -> Sequence[Row]:
+    """(time, *columns) rows of a building with start ≤ time < end, in time order."""
+    time = measurements.c[TIME]
+    query = select(time, *(measurements.c[c] for c in columns)).where(
+        measurements.c.building_id == building_id
+    )
+    if start is not None:
+        query = query.where(time >= start)
+    if end is not None:
+        query = query.where(time < end)
+    return session.execute(query.order_by(time)).all()
+
+
+def measurement_summary(
+    session: Session, building_id: int
+) -> tuple[int, datetime | None, datetime | None]:
+    """Row count, first and last stored time of a building."""
+    time = measurements.c[TIME]
+    query = select(func.count(), func.min(time), func.max(time)).where(
+        measurements.c.building_id == building_id
+    )
+    rows, first, last = session.execute(query).one()
+    return rows, first, last
+
+
+# --- jobs -------------------------------------------------------------------------------------
+def add_job(session: Session, building_id: int, trigger: str, model: str, days: int) -> JobRecord:
+    """A queued job; ConflictError when the building already has one queued or running."""
+    active = active_job(session, building_id)
+    if active is not None:
+        raise ConflictError(
+            f"building {building_id} already has calibration job {active.id} {active.status}; "
+            f"poll GET /jobs/{active.id}"
+        )
+    building = get_building(session, building_id)
+    job = JobRecord(
+        building_id=building_id,
+        status=QUEUED,
+        trigger=trigger,
+        model=model,
+        days=days,
+        data_revision=building.data_revision,
+    )
+    try:
+        with session.begin_nested():
+            session.add(job)
+    except IntegrityError as exc:  # another process queued one between the check and now
+        raise ConflictError(f"building {building_id} already has an active calibration") from exc
+    return job
+
+
+def active_job(session: Session, building_id: int) -> JobRecord | None:
+    query = select(JobRecord).where(
+        JobRecord.building_id == building_id, JobRecord.status.in_(ACTIVE_JOB_STATUSES)
+    )
+    return session.scalars(query).first()
+
+
+def get_job(session: Session, job_id: int) -> JobRecord:
+    job = session.get(JobRecord, job_id)
+    if job is None:
+        raise NotFoundError(f"job {job_id} not found")
+    return job
+
+
+def list_jobs(session: Session, building_id: int, limit: int) -> Sequence[JobRecord]:
+    query = (
+        select(JobRecord)
+        .where(JobRecord.building_id == building_id)
+        .order_by(JobRecord.id.desc())
+        .limit(limit)
+    )
+    return session.scalars(query).all()
+
+
+def start_job(session: Session, job_id: int) -> JobRecord:
+    job = get_job(session, job_id)
+    if job.status != QUEUED:
+        raise ConflictError(f"job {job_id} is {job.status}, not queued")
+    job.status, job.started_at = RUNNING, utc_now()
+    return job
+
+
+def finish_job(
+    session: Session,
+    job_id: int,
+    status: str,
+    *,
+    outcome: str | None = None,
+    error: str | None = None,
+    details: dict[str, Any] | None = None,
+) -> JobRecord:
+    job = get_job(session, job_id)
+    job.status, job.outcome, job.error = status, outcome, error
+    job.details = details
+    job.finished_at = utc_now()
+    return job
+
+
+def fail_active_jobs(session: Session, reason: str) -> list[int]:
+    """Mark every queued or running job failed (at start-up: their process is gone)."""
+    query = select(JobRecord).where(JobRecord.status.in_(ACTIVE_JOB_STATUSES))
+    jobs = session.scalars(query).all()
+    for job in jobs:
+        job.status, job.error, job.finished_at = FAILED, reason, utc_now()
+    return [job.id for job in jobs]
+
+
+def buildings_with_new_data(session: Session) -> list[int]:
+    """Buildings whose data changed since their last calibration job (or that never had one)."""
+    last_job = (
+        select(JobRecord.building_id, func.max(JobRecord.data_revision).label("revision"))
+        .group_by(JobRecord.building_id)
+        .subquery()
+    )
+    query = (
+        select(BuildingRecord.id)
+        .outerjoin(last_job, last_job.c.building_id == BuildingRecord.id)
+        .where(
+            BuildingRecord.data_revision > 0,
+            (last_job.c.revision.is_(None)) | (BuildingRecord.data_revision > last_job.c.revision),
+        )
+        .order_by(BuildingRecord.id)
+    )
+    return list(session.scalars(query))
+
+
+# --- parameter sets ---------------------------------------------------------------------------
+def current_parameter_set(session: Session, building_id: int) -> ParameterSetRecord | None:
+    query = select(ParameterSetRecord).where(
+        ParameterSetRecord.building_id == building_id, ParameterSetRecord.is_current
+    )
+    return session.scalars(query).first()
+
+
+def get_parameter_set(session: Session, building_id: int, set_id: int) -> ParameterSetRecord:
+    record = session.get(ParameterSetRecord, set_id)
+    if record is None or record.building_id != building_id:
+        raise NotFoundError(f"parameter set {set_id} not found for building {building_id}")
+    return record
+
+
+def list_parameter_sets(session: Session, building_id: int) -> Sequence[ParameterSetRecord]:
+    query = (
+        select(ParameterSetRecord)
+        .where(ParameterSetRecord.building_id == building_id)
+        .order_by(ParameterSetRecord.id.desc())
+    )
+    return session.scalars(query).all()
+
+
+def add_parameter_set(
+    session: Session, record: ParameterSetRecord, promote: bool
+) -> ParameterSetRecord:
+    """Store a fitted set; when promoted it becomes current and the previous one superseded."""
+    if promote:
+        session.execute(
+            update(ParameterSetRecord)
+            .where(
+                ParameterSetRecord.building_id == record.building_id,
+                ParameterSetRecord.is_current,
+            )
+            .values(is_current=False, status=SUPERSEDED)
+        )
+    record.is_current, record.status = promote, CURRENT if promote else REJECTED
+    session.add(record)
+    session.flush()
+    return record
+
+
+def forecast_key(session: Session | Connection, building_id: int) -> Row:
+    """(data_revision, set_id, timezone, step_s, last_measured_at) of a building in one query;
+    ``set_id`` is the current parameter set's, or None."""
+    query = (
+        select(
+            BuildingRecord.data_revision,
+            ParameterSetRecord.id.label("set_id"),
+            BuildingRecord.timezone,
+            BuildingRecord.step_s,
+            BuildingRecord.last_measured_at,
+        )
+        .outerjoin(
+            ParameterSetRecord,
+            and_(
+                ParameterSetRecord.building_id == BuildingRecord.id,
+                ParameterSetRecord.is_current,
+            ),
+        )
+        .where(BuildingRecord.id == building_id)
+    )
+    row = session.execute(query).first()
+    if row is None:
+        raise NotFoundError(f"building {building_id} not found")
+    return row
+
+
+# --- admin token ------------------------------------------------------------------------------
+def stored_admin_token_hash(session: Session) -> str | None:
+    query = select(AdminTokenRecord.token_hash).order_by(AdminTokenRecord.id.desc())
+    return session.scalars(query).first()
+
+
+def replace_admin_token_hash(session: Session, token_hash: str) -> None:
+    for record in session.scalars(select(AdminTokenRecord)):
+        session.delete(record)
+    session.add(AdminTokenRecord(token_hash=token_hash))

@@ -1,0 +1,133 @@
+"""Buildings: the CONTRACT.md §2 description in, the id and token out."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field
+
+EXAMPLE = {
+    "name": "office-torino",
+    "location": {
+        "latitude": 45.22,
+        "longitude": 7.65,
+        "altitude": 287.0,
+        "timezone": "Europe/Rome",
+    },
+    "floor_area": 1050.0,
+    "volume": 3150.0,
+    "wall_area": 455.0,
+    "internal_mass_area": 560.0,
+    "windows": [
+        {"azimuth": 90.0, "tilt": 90.0, "area": 45.6},
+        {"azimuth": 270.0, "tilt": 90.0, "area": 45.6},
+    ],
+    "walls": [{"azimuth": 0.0, "tilt": 90.0, "area": 63.0}],
+}
+
+
+class SurfaceIn(BaseModel):
+    azimuth: float = Field(description="Degrees clockwise from north (90 = east). [°]")
+    tilt: float = Field(description="Degrees from horizontal (90 = vertical). [°]")
+    area: float = Field(description="[m²]")
+
+
+class LocationIn(BaseModel):
+    latitude: float = Field(description="[°]")
+    longitude: float = Field(description="[°]")
+    altitude: float | None = Field(None, description="[m]")
+    timezone: str | None = Field(None, description="IANA name, e.g. Europe/Rome (default UTC)")
+
+
+class BuildingCreate(BaseModel):
+    """CONTRACT.md §2. Ranges are checked by ``rcengine.building.Building.from_dict``."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [EXAMPLE]})
+
+    name: str = Field("building", max_length=200)
+    location: LocationIn
+    floor_area: float = Field(description="[m²]")
+    volume: float = Field(description="[m³]")
+    wall_area: float = Field(description="[m²]")
+    internal_mass_area: float | None = Field(None, description="[m²]")
+    windows: list[SurfaceIn] = Field(default_factory=list)
+    walls: list[SurfaceIn] = Field(default_factory=list)
+
+
+class BuildingCreated(BaseModel):
+    """The building's token is shown here once; the service keeps only its hash."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "id": 1,
+                    "name": "office-torino",
+                    "token": "0b3Xq1u8Yf3n8m0c2r3vJ8b9J1ZKq7w3fX4o5p6q7r8",
+                    "created_at": "2017-01-09T06:15:00+01:00",
+                }
+            ]
+        }
+    )
+
+    id: int
+    name: str
+    token: str = Field(description="Bearer token for this building's calls; shown only once")
+    created_at: str
+
+
+class TokenRotated(BaseModel):
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"id": 1, "token": "mS0n2r9vJ8b9J1ZKq7w3fX4o5p6q7r80b3Xq1u8Yf3n"}]
+        }
+    )
+
+    id: int
+    token: str
+
+
+class BuildingRead(BaseModel):
+    """A building with a summary of its stored data and current parameter set."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {
+                    "id": 1,
+                    "name": "office-torino",
+                    "timezone": "Europe/Rome",
+                    "description": EXAMPLE,
+                    "created_at": "2017-01-09T06:15:00+01:00",
+                    "step_s": 900.0,
+                    "rows": 2112,
+                    "first_time": "2017-01-09T00:00:00+01:00",
+                    "last_time": "2017-01-30T23:45:00+01:00",
+                    "last_measured_time": "2017-01-29T23:45:00+01:00",
+                    "data_revision": 3,
+                    "current_parameter_set_id": 2,
+                }
+            ]
+        }
+    )
+
+    id: int
+    name: str
+    timezone: str
+    description: dict
+    created_at: str
+    step_s: float | None = Field(description="Time step of the stored series. [s]")
+    rows: int
+    first_time: str | None
+    last_time: str | None
+    last_measured_time: str | None = Field(description="Latest row with a measured t_in")
+    data_revision: int = Field(description="Incremented by every upload")
+    current_parameter_set_id: int | None
+
+
+class BuildingList(BaseModel):
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [{"items": BuildingRead.model_config["json_schema_extra"]["examples"]}]
+        }
+    )
+
+    items: list[BuildingRead]

@@ -1,0 +1,69 @@
+"""Calibration jobs."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+JOB_EXAMPLE = {
+    "id": 12,
+    "building_id": 1,
+    "status": "succeeded",
+    "outcome": "promoted",
+    "trigger": "api",
+    "model": "basic",
+    "days": 7,
+    "created_at": "2017-01-31T02:00:00+01:00",
+    "started_at": "2017-01-31T02:00:01+01:00",
+    "finished_at": "2017-01-31T02:00:03+01:00",
+    "error": None,
+    "parameter_set_id": 4,
+    "details": {
+        "reason": "held-out day RMSE 0.412 K is no worse than the current set's 0.530 K",
+        "window": {
+            "train_start": "2017-01-22T23:00:00+00:00",
+            "holdout_start": "2017-01-29T23:00:00+00:00",
+            "end": "2017-01-30T23:00:00+00:00",
+            "step_s": 900.0,
+        },
+    },
+}
+
+
+class CalibrationRequest(BaseModel):
+    model_config = ConfigDict(
+        extra="forbid", json_schema_extra={"examples": [{"days": 7, "model": "basic"}]}
+    )
+
+    days: int | None = Field(
+        None, ge=1, le=365, description="Days fitted before the held-out day (default 7)"
+    )
+    model: str | None = Field(None, description="Model of the rcengine library (default basic)")
+
+
+class JobRead(BaseModel):
+    """status: queued | running | succeeded | failed. A succeeded job's outcome says whether
+    its parameter set was promoted to current or rejected (worse on the held-out day)."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [JOB_EXAMPLE]})
+
+    id: int
+    building_id: int
+    status: str
+    outcome: str | None = Field(description="promoted | rejected (succeeded jobs)")
+    trigger: str = Field(description="api | schedule | cli")
+    model: str
+    days: int
+    created_at: str
+    started_at: str | None
+    finished_at: str | None
+    error: str | None = Field(description="Why a failed job failed")
+    parameter_set_id: int | None
+    details: dict[str, Any] | None
+
+
+class JobList(BaseModel):
+    model_config = ConfigDict(json_schema_extra={"examples": [{"items": [JOB_EXAMPLE]}]})
+
+    items: list[JobRead]

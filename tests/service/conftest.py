@@ -1,0 +1,185 @@
+"""Fixtures of the service tests: an in-process app on a fresh SQLite file, data, a real server.
+
+In-process tests use FastAPI's TestClient with calibrations on a thread (``workers=0``), so that a
+test can monkeypatch the calibration; the live-server tests run ``rcservice serve`` in a
+subprocess with its real process pool.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO
+
+import httpx
+import numpy as np
+import pandas as pd
+import pytest
+from fastapi.testclient import TestClient
+
+from rcengine.io.timeseries import format_times
+from service.core.config import Settings
+from service.main import create_app
+
+from ..synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+
+ADMIN_TOKEN = "test-admin-token-0123456789abcdef"
+ADMIN = {"Authorization": f"Bearer {ADMIN_TOKEN}"}
+TIMEZONE = "Europe/Rome"
+SYNTHETIC_BUILDING = {**BUILDING.to_dict(), "name": "synthetic-office"}
+OFFICE = Path(__file__).resolve().parents[2] / "data" / "energyplus" / "office"
+
+
+def bearer(token: str) -> dict[str, str]:
+    return {"Authorization": f"Bearer {token}"}
+
+
+def json_rows(frame: pd.DataFrame, timezone: str = TIMEZONE) -> list[dict]:
+    """Contract rows as the JSON upload carries them: local times with offset, null for NaN."""
+    times = format_times(frame.index, timezone)
+    rows = []
+    for t, values in zip(times, frame.to_dict("records"), strict=True):
+        rows.append({"time": t, **{k: (None if pd.isna(v) else v) for k, v in values.items()}})
+    return rows
+
+
+# --- in-process app -------------------------------------------------------------------------
+@pytest.fixture
+def settings(tmp_path: Path) -> Settings:
+    return Settings(
+        database_url=f"sqlite:///{tmp_path / 'rcservice.db'}",
+        admin_token=ADMIN_TOKEN,
+        workers=0,
+        scheduler_enabled=False,
+        max_body_bytes=200_000,
+    )
+
+
+@pytest.fixture
+def client(settings: Settings) -> Iterator[TestClient]:
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+def register(
+    client: TestClient | httpx.Client, description: dict | None = None
+) -> tuple[int, dict]:
+    """Register a building with the admin token; returns its id and auth headers."""
+    response = client.post("/buildings", json=description or SYNTHETIC_BUILDING, headers=ADMIN)
+    assert response.status_code == 201, response.text
+    body = response.json()
+    return body["id"], bearer(body["token"])
+
+
+def wait_for_job(client: TestClient | httpx.Client, job_id: int, headers: dict, timeout_s=60.0):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        job = client.get(f"/jobs/{job_id}", headers=headers).json()
+        if job["status"] in ("succeeded", "failed"):
+            return job
+        time.sleep(0.05)
+    raise AssertionError(f"job {job_id} did not finish in {timeout_s} s: {job}")
+
+
+# --- data -------------------------------------------------------------------------------------
+@pytest.fixture(scope="session")
+def synthetic() -> pd.DataFrame:
+    """Four days at 15 min with t_in from the hand-written 3R3C reference (tests/synthetic.py)."""
+    frame = weather_and_gains(days=4, seed=5)
+    frame["t_in"] = basic_reference(frame, TRUTH_BASIC, x0=(8.0, 19.0, 18.5))
+    return frame[["t_in", "t_out", "ghi", "q_hvac", "q_occ", "q_light"]]
+
+
+@pytest.fixture(scope="session")
+def office() -> tuple[dict, pd.DataFrame]:
+    """The EnergyPlus office: building JSON and the heating-season CSV, cells as text."""
+    csv, building = OFFICE / "heating.csv", OFFICE / "building.json"
+    if not (csv.exists() and building.exists()):
+        pytest.skip(f"EnergyPlus reference data not found in {OFFICE}")
+    raw = pd.read_csv(csv, dtype=str, keep_default_na=False)
+    raw.index = pd.to_datetime(raw["time"], utc=True)
+    return json.loads(building.read_text()), raw
+
+
+# --- a real server ----------------------------------------------------------------------------
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class LiveServer:
+    """``rcservice serve`` in a subprocess on a SQLite file; stderr goes to a log file."""
+
+    def __init__(self, folder: Path, **env: str):
+        self.folder = folder
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.env = {
+            **os.environ,
+            "RCSERVICE_DATABASE_URL": f"sqlite:///{folder / 'rcservice.db'}",
+            "RCSERVICE_ADMIN_TOKEN": ADMIN_TOKEN,
+            "RCSERVICE_SCHEDULER_ENABLED": "false",
+            **env,
+        }
+        self.process: subprocess.Popen | None = None
+        self.starts = 0
+        self._log: IO[str] | None = None
+
+    def start(self) -> LiveServer:
+        self.starts += 1
+        self._log = (self.folder / f"server-{self.starts}.log").open("w")
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port)],
+            env=self.env,
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+            cwd=self.folder,
+        )
+        deadline = time.monotonic() + 30.0
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"server exited: {self.log()}")
+            try:
+                if httpx.get(f"{self.url}/health", timeout=1.0).status_code == 200:
+                    return self
+            except httpx.TransportError:
+                time.sleep(0.1)
+        raise RuntimeError(f"server did not answer /health in 30 s: {self.log()}")
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        if self._log is not None:
+            self._log.close()
+
+    def log(self) -> str:
+        return (self.folder / f"server-{self.starts}.log").read_text()[-4000:]
+
+    def client(self, **kwargs) -> httpx.Client:
+        return httpx.Client(base_url=self.url, timeout=60.0, **kwargs)
+
+
+@pytest.fixture
+def live_server(tmp_path: Path) -> Iterator[LiveServer]:
+    server = LiveServer(tmp_path)
+    try:
+        yield server.start()
+    finally:
+        server.stop()
+
+
+def rmse(a, b) -> float:
+    return float(np.sqrt(np.mean((np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) ** 2)))

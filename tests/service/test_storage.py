@@ -1,0 +1,208 @@
+"""Storage: the migration matches the tables, SQLite settings, constraints the database itself
+enforces, retraining selection, the scheduler and the ``rcservice`` command line."""
+
+from __future__ import annotations
+
+import io
+from datetime import UTC, datetime, timedelta, timezone
+
+import pytest
+from alembic import command
+from alembic.autogenerate import compare_metadata
+from alembic.migration import MigrationContext
+from sqlalchemy import insert, text
+from sqlalchemy.dialects import postgresql
+from sqlalchemy.exc import IntegrityError, StatementError
+from typer.testing import CliRunner
+
+from service import repository
+from service.cli import app as cli
+from service.core.config import Settings
+from service.core.db import Database, alembic_config
+from service.jobs import JobRunner
+from service.models import Base, JobRecord, ParameterSetRecord
+from service.scheduler import JOB_ID, start_scheduler
+
+from .conftest import json_rows, register
+
+
+@pytest.fixture
+def db(settings):
+    database = Database(settings.database_url)
+    database.migrate()
+    yield database
+    database.dispose()
+
+
+def test_migration_creates_exactly_the_tables_of_the_models(db):
+    with db.engine.connect() as connection:
+        differences = compare_metadata(MigrationContext.configure(connection), Base.metadata)
+    assert differences == []
+
+
+def test_sqlite_runs_in_wal_with_foreign_keys_and_a_busy_timeout(db):
+    with db.session() as session:
+        assert session.execute(text("PRAGMA journal_mode")).scalar() == "wal"
+        assert session.execute(text("PRAGMA foreign_keys")).scalar() == 1
+        assert session.execute(text("PRAGMA busy_timeout")).scalar() == 30_000
+
+
+def test_times_are_stored_as_utc_instants(db):
+    rome = timezone(timedelta(hours=1))
+    with db.write() as session:
+        building = repository.add_building(session, "b", {}, "Europe/Rome", "h" * 64)
+        building.grid_origin = datetime(2017, 1, 9, 6, 15, tzinfo=rome)
+    with db.session() as session:
+        stored = repository.get_building(session, building.id).grid_origin
+    assert stored == datetime(2017, 1, 9, 5, 15, tzinfo=UTC) and stored.tzinfo == UTC
+    with pytest.raises(StatementError, match="naive datetime"), db.write() as session:
+        repository.get_building(session, building.id).grid_origin = datetime(2017, 1, 9)
+
+
+def _job_values(building_id: int, status: str) -> dict:
+    return {
+        "building_id": building_id,
+        "status": status,
+        "trigger": "api",
+        "model": "basic",
+        "days": 7,
+        "data_revision": 0,
+        "created_at": datetime.now(UTC),
+    }
+
+
+def test_database_refuses_a_second_active_job_for_a_building(db):
+    with db.write() as session:
+        building = repository.add_building(session, "b", {}, "UTC", "h" * 64)
+        session.execute(insert(JobRecord), [_job_values(building.id, "running")])
+        session.execute(insert(JobRecord), [_job_values(building.id, "failed")])
+    with pytest.raises(IntegrityError), db.write() as session:
+        session.execute(insert(JobRecord), [_job_values(building.id, "queued")])
+
+
+def test_database_refuses_two_current_sets_for_a_building(db):
+    def values(building_id):
+        now = datetime.now(UTC)
+        return {
+            "building_id": building_id,
+            "model": "basic",
+            "status": "current",
+            "is_current": True,
+            "train_start": now,
+            "train_end": now,
+            "metrics": {},
+            "engine_version": "0",
+            "document": {},
+            "created_at": now,
+        }
+
+    with db.write() as session:
+        building = repository.add_building(session, "b", {}, "UTC", "h" * 64)
+        session.execute(insert(ParameterSetRecord), [values(building.id)])
+    with pytest.raises(IntegrityError), db.write() as session:
+        session.execute(insert(ParameterSetRecord), [values(building.id)])
+
+
+def test_deleting_a_building_deletes_its_rows(client, settings, synthetic):
+    building_id, headers = register(client)
+    client.post(
+        f"/buildings/{building_id}/measurements",
+        json={"rows": json_rows(synthetic.iloc[:4])},
+        headers=headers,
+    )
+    database = Database(settings.database_url)
+    with database.write() as session:
+        session.execute(text("DELETE FROM buildings WHERE id = :id"), {"id": building_id})
+    with database.session() as session:
+        assert session.execute(text("SELECT count(*) FROM measurements")).scalar() == 0
+    database.dispose()
+
+
+def test_retraining_picks_buildings_with_new_data_since_their_last_job(client, settings, synthetic):
+    with_data, headers = register(client)
+    register(client)  # no data: never due
+    database = Database(settings.database_url)
+    with database.session() as session:
+        assert repository.buildings_with_new_data(session) == []
+    rows = json_rows(synthetic.iloc[:96])
+    client.post(f"/buildings/{with_data}/measurements", json={"rows": rows}, headers=headers)
+    with database.session() as session:
+        assert repository.buildings_with_new_data(session) == [with_data]
+    with database.write() as session:
+        job = repository.add_job(session, with_data, "schedule", "basic", 7)
+        repository.finish_job(session, job.id, "failed", error="x")
+    with database.session() as session:
+        assert repository.buildings_with_new_data(session) == []  # nothing new since that job
+    client.post(f"/buildings/{with_data}/measurements", json={"rows": rows[:4]}, headers=headers)
+    with database.session() as session:
+        assert repository.buildings_with_new_data(session) == [with_data]
+    database.dispose()
+
+
+def test_retrain_all_command_calibrates_due_buildings_once(
+    client, settings, synthetic, monkeypatch
+):
+    building_id, headers = register(client)
+    client.post(
+        f"/buildings/{building_id}/measurements",
+        json={"rows": json_rows(synthetic.iloc[: 3 * 96])},
+        headers=headers,
+    )
+    monkeypatch.setenv("RCSERVICE_DATABASE_URL", settings.database_url)
+    monkeypatch.setenv("RCSERVICE_TRAINING_DAYS", "1")
+    runner = CliRunner()
+    first = runner.invoke(cli, ["retrain-all"])
+    assert first.exit_code == 0, first.output
+    assert "job 1: succeeded" in first.output and "1 job(s) run" in first.output
+    sets = client.get(f"/buildings/{building_id}/parameters", headers=headers).json()
+    assert sets["current_id"] is not None
+    jobs = client.get(f"/buildings/{building_id}/calibrations", headers=headers).json()["items"]
+    assert [(j["trigger"], j["days"]) for j in jobs] == [("cli", 1)]
+    second = runner.invoke(cli, ["retrain-all"])
+    assert second.exit_code == 0 and "0 job(s) run" in second.output
+
+
+def test_nightly_job_is_scheduled_at_the_local_hour(settings):
+    local = Settings(**{**settings.model_dump(), "retrain_hour": 3, "timezone": "Europe/Rome"})
+    database = Database(local.database_url)
+    database.migrate()
+    runner = JobRunner(local, database)
+    scheduler = start_scheduler(local, database, runner)
+    try:
+        next_run = scheduler.get_job(JOB_ID).next_run_time
+        assert (next_run.hour, next_run.minute) == (3, 0)
+        assert str(next_run.tzinfo) == "Europe/Rome"
+    finally:
+        scheduler.shutdown(wait=False)
+        runner.shutdown()
+        database.dispose()
+
+
+def test_invalid_settings_fail_at_start():
+    with pytest.raises(ValueError, match="invalid model"):
+        Settings(model="7r7c")
+    with pytest.raises(ValueError, match="unknown time zone"):
+        Settings(timezone="Mars/Base")
+    with pytest.raises(ValueError, match="invalid preset"):
+        Settings(preset="fastest")
+
+
+def test_schema_and_upsert_compile_for_postgresql():
+    """No PostgreSQL server here: check the SQL the same code emits for it."""
+    config = alembic_config("postgresql://user@localhost/rcservice")
+    config.output_buffer = io.StringIO()
+    command.upgrade(config, "head", sql=True)
+    ddl = config.output_buffer.getvalue()
+    assert (
+        "CREATE UNIQUE INDEX uq_jobs_active_building ON jobs (building_id) "
+        "WHERE status IN ('queued', 'running')" in ddl
+    )
+    assert "CREATE UNIQUE INDEX uq_parameter_sets_current_building ON parameter_sets " in ddl
+    assert "time TIMESTAMP WITH TIME ZONE NOT NULL" in ddl
+    upsert = str(
+        repository.upsert_statement("postgresql", ["t_in"]).compile(dialect=postgresql.dialect())
+    )
+    assert (
+        "ON CONFLICT (building_id, time) DO UPDATE SET "
+        "t_in = coalesce(excluded.t_in, measurements.t_in)" in upsert
+    )
