@@ -78,7 +78,7 @@ class Dataset:
 
     def with_columns(self, extra: pd.DataFrame) -> Dataset:
         """The same rows with more columns (derived signals), aligned on time."""
-        return Dataset(self.frame.join(extra, how="left", rsuffix="_derived"), self.step_s)
+        return Dataset(self.frame.join(extra, how="left", suffixes=("", "_derived")), self.step_s)
 
     def _subset(self, mask: np.ndarray) -> Dataset:
         if not mask.any():

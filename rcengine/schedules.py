@@ -18,6 +18,24 @@ def hour_of_week(times: pd.DatetimeIndex, timezone: str) -> np.ndarray:
     return np.asarray(local.day_of_week * 24 + local.hour, dtype=int)
 
 
+# Day types of building schedules (EnergyPlus's "Weekdays", "Saturday", "Sunday"): index of each
+# day of the week, Monday first.
+DAY_TYPE_OF_WEEKDAY = np.array([0, 0, 0, 0, 0, 1, 2])
+N_DAY_TYPES = 3
+
+
+def day_type_hour(times: pd.DatetimeIndex, timezone: str) -> np.ndarray:
+    """0–23 = weekday hours, 24–47 = Saturday, 48–71 = Sunday, in local time."""
+    local = times.tz_convert(timezone)
+    return np.asarray(DAY_TYPE_OF_WEEKDAY[local.day_of_week] * 24 + local.hour, dtype=int)
+
+
+def weekly_from_day_types(profile: np.ndarray) -> np.ndarray:
+    """Expand a (72,) weekday/Saturday/Sunday hourly profile to the (168,) week."""
+    profile = np.asarray(profile, dtype=float).reshape(N_DAY_TYPES, 24)
+    return profile[DAY_TYPE_OF_WEEKDAY].ravel()
+
+
 def weekly_profile(
     values: np.ndarray, times: pd.DatetimeIndex, timezone: str
 ) -> np.ndarray:

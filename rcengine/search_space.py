@@ -58,7 +58,7 @@ class SearchSpace:
         lo = np.where(self.log, np.log(np.where(self.log, self.lower, 1.0)), self.lower)
         hi = np.where(self.log, np.log(np.where(self.log, self.upper, 1.0)), self.upper)
         values = lo + unit * (hi - lo)
-        values = np.where(self.log, np.exp(values), values)
+        values = np.where(self.log, np.exp(np.where(self.log, values, 0.0)), values)
         theta = np.tile(self._template, (unit.shape[0], 1))
         theta[:, self._free_idx] = values
         return theta

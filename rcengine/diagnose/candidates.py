@@ -10,17 +10,30 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
 
 from ..building import Building
 from ..columns import Q_HVAC, T_OUT, WIND_SPEED
+from ..dataset import Dataset
 from ..network import Parameter, RCNetwork
-from ..schedules import describe, on_hours, weekly_profile
+from ..schedules import (
+    N_DAY_TYPES,
+    day_type_hour,
+    describe,
+    on_hours,
+    schedule_signal,
+    weekly_from_day_types,
+)
 from ..signals import T_REF_C, SignalOptions
+from ..solar import orientation_key
+from .response import explain_residual, node_responses, parameter_sensitivities
 
 AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
+# Shares of the learnt profile's peak tried as the on/off threshold of a schedule.
+ON_SHARES = (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8)
 
 
 @dataclass(frozen=True)
@@ -34,6 +47,10 @@ class Extension:
     new_parameters: tuple[str, ...]
     inputs: tuple[tuple[str, str], ...] = ()  # (signal, node) of new heat inputs, for screening
     structural: bool = False  # changes the dynamics (new node / re-routing), screened by a refit
+    learnt: bool = False  # its input's shape is learnt from the residual (refined after a refit)
+    # Values of the new parameters at which the extension does nothing: the refit's warm start
+    # then contains the current model itself, so it can only improve on it.
+    neutral: dict[str, float] = field(default_factory=dict)
     detail: dict = field(default_factory=dict)
 
 
@@ -49,10 +66,19 @@ class Context:
 
     network: RCNetwork
     building: Building
-    train: pd.DataFrame  # contract columns, UTC index
+    data: Dataset  # training period with the current model's signals
     signals: SignalOptions
-    innovations: np.ndarray  # one-step-ahead Kalman errors on ``train`` (measured − predicted) [K]
-    step_s: float
+    params: dict[str, float]  # the current model's fitted parameters
+    residual: np.ndarray  # open-loop simulation error on ``data`` (measured − simulated) [K]
+
+    @property
+    def train(self) -> pd.DataFrame:
+        return self.data.frame
+
+    @cached_property
+    def sensitivities(self) -> np.ndarray:
+        """∂y/∂ln p of the current model on the training period (T, n_params). [K]"""
+        return parameter_sensitivities(self.network, self.params, self.data)
 
 
 def _name(net: RCNetwork, effect: str) -> str:
@@ -75,10 +101,6 @@ def _has_signal(net: RCNetwork, prefix: str) -> bool:
     return any(s.startswith(prefix) for s in net.signals)
 
 
-def _orientation(azimuth: float, tilt: float) -> str:
-    return f"{azimuth:g}_{tilt:g}"
-
-
 def _facade(azimuth: float, tilt: float) -> str:
     if tilt < 30:
         return "roof"
@@ -95,6 +117,46 @@ def _facade(azimuth: float, tilt: float) -> str:
     return names[int(((azimuth % 360) + 22.5) // 45) % 8]
 
 
+def _solar_by_orientation(
+    ctx: Context,
+    effect: str,
+    kind: str,
+    target: str,
+    upper: float,
+    meaning: Callable[[str, float], str],
+) -> Extension:
+    """One gain per orientation of the building's ``kind`` surfaces ("window" or "opaque"),
+    feeding ``solar_<kind>_<orientation>`` (irradiance × area [W]) into ``target``."""
+    surfaces = ctx.building.windows if kind == "window" else ctx.building.walls
+    net = ctx.network.copy(_name(ctx.network, effect))
+    groups: dict[str, tuple[str, float]] = {}
+    for s in surfaces:
+        key = orientation_key(s.azimuth, s.tilt)
+        area = groups.get(key, ("", 0.0))[1] + s.area
+        groups[key] = (_facade(s.azimuth, s.tilt), area)
+    params, inputs = [], []
+    for key, (facade, area) in groups.items():
+        name = f"{'g' if kind == 'window' else 'a'}_{kind}_{key}"
+        net.add_parameter(Parameter(name, "-", 0.0, upper, meaning(facade, area)))
+        signal = f"solar_{kind}_{key}"
+        net.add_heat_input(signal, target, name)
+        params.append(name)
+        inputs.append((signal, target))
+    detail = {
+        "orientations": {k: {"area_m2": a, "facade": f} for k, (f, a) in groups.items()},
+        "node": target,
+    }
+    return Extension(
+        effect,
+        net,
+        ctx.signals,
+        tuple(params),
+        tuple(inputs),
+        neutral=dict.fromkeys(params, 0.0),
+        detail=detail,
+    )
+
+
 def window_solar_gains(ctx: Context) -> Extension | Skipped:
     """Solar heat through the glazing, one gain per façade orientation, into the interior mass."""
     effect = "window_solar_gains"
@@ -102,38 +164,36 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
         return Skipped(effect, "no windows in the building JSON")
     if _has_signal(ctx.network, "solar_window"):
         return Skipped(effect, "the model already has window solar gains")
-    net = ctx.network.copy(_name(ctx.network, effect))
-    target = mass_node(net)
-    groups: dict[str, float] = {}
-    for w in ctx.building.windows:
-        key = _orientation(w.azimuth, w.tilt)
-        groups[key] = groups.get(key, 0.0) + w.area
-    params, inputs = [], []
-    for key, area in groups.items():
-        az, tilt = (float(v) for v in key.split("_"))
-        name = f"g_window_{key}"
-        net.add_parameter(
-            Parameter(
-                name,
-                "-",
-                0.0,
-                0.9,
-                f"share of the irradiance on the {_facade(az, tilt)} glazing ({area:g} m²) "
-                "that heats the zone (solar heat gain coefficient)",
-            )
+    ext = _solar_by_orientation(
+        ctx,
+        effect,
+        "window",
+        mass_node(ctx.network),
+        0.9,
+        lambda facade, area: f"share of the irradiance on the {facade} glazing ({area:g} m²) "
+        "that heats the zone (solar heat gain coefficient)",
+    )
+    if T_OUT in ctx.network.neighbours(ctx.network.output):
+        return ext
+    # Glazing is also a massless conductance between the air and outdoors; a model whose only
+    # path outdoors runs through the wall capacity cannot take the windows in without it.
+    glazing = sum(w.area for w in ctx.building.windows)
+    ext.network.add_parameter(
+        Parameter(
+            "r_window",
+            "m²K/W",
+            0.1,
+            100.0,
+            f"thermal resistance of the glazing ({glazing:g} m²), surface films included",
         )
-        signal = f"solar_window_{key}"
-        net.add_heat_input(signal, target, name)
-        params.append(name)
-        inputs.append((signal, target))
-    detail = {
-        "orientations": {
-            k: {"area_m2": a, "facade": _facade(*map(float, k.split("_")))}
-            for k, a in groups.items()
-        },
-        "node": target,
-    }
-    return Extension(effect, net, ctx.signals, tuple(params), tuple(inputs), detail=detail)
+    )
+    ext.network.add_resistor(T_OUT, ctx.network.output, "r_window", factor=1.0 / glazing)
+    return replace(
+        ext,
+        new_parameters=(*ext.new_parameters, "r_window"),
+        neutral={**ext.neutral, "r_window": 100.0},
+        detail={**ext.detail, "glazing_area_m2": glazing},
+    )
 
 
 def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
@@ -143,38 +203,15 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
         return Skipped(effect, "no opaque walls ('walls') in the building JSON")
     if _has_signal(ctx.network, "solar_opaque"):
         return Skipped(effect, "the model already has opaque solar gains")
-    net = ctx.network.copy(_name(ctx.network, effect))
-    target = envelope_node(net)
-    groups: dict[str, float] = {}
-    for w in ctx.building.walls:
-        key = _orientation(w.azimuth, w.tilt)
-        groups[key] = groups.get(key, 0.0) + w.area
-    params, inputs = [], []
-    for key, area in groups.items():
-        az, tilt = (float(v) for v in key.split("_"))
-        name = f"a_opaque_{key}"
-        net.add_parameter(
-            Parameter(
-                name,
-                "-",
-                0.0,
-                0.3,
-                f"share of the irradiance on the {_facade(az, tilt)} opaque surfaces ({area:g} m²) "
-                "reaching the envelope node (absorptance × inward fraction)",
-            )
-        )
-        signal = f"solar_opaque_{key}"
-        net.add_heat_input(signal, target, name)
-        params.append(name)
-        inputs.append((signal, target))
-    detail = {
-        "orientations": {
-            k: {"area_m2": a, "facade": _facade(*map(float, k.split("_")))}
-            for k, a in groups.items()
-        },
-        "node": target,
-    }
-    return Extension(effect, net, ctx.signals, tuple(params), tuple(inputs), detail=detail)
+    return _solar_by_orientation(
+        ctx,
+        effect,
+        "opaque",
+        envelope_node(ctx.network),
+        0.3,
+        lambda facade, area: f"share of the irradiance on the {facade} opaque surfaces "
+        f"({area:g} m²) reaching the envelope node (absorptance × inward fraction)",
+    )
 
 
 def wind_infiltration(ctx: Context) -> Extension | Skipped:
@@ -196,14 +233,47 @@ def wind_infiltration(ctx: Context) -> Extension | Skipped:
     net.add_heat_input("wind_loss", net.output, "k_wind")
     detail = {"volume_m3": ctx.building.volume}
     return Extension(
-        effect, net, ctx.signals, ("k_wind",), (("wind_loss", net.output),), detail=detail
+        effect,
+        net,
+        ctx.signals,
+        ("k_wind",),
+        (("wind_loss", net.output),),
+        neutral={"k_wind": 0.0},
+        detail=detail,
     )
 
 
-def _learnt_schedule(ctx: Context, values: np.ndarray) -> np.ndarray:
-    return on_hours(
-        np.maximum(weekly_profile(values, ctx.train.index, ctx.building.location.timezone), 0.0)
+def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> np.ndarray:
+    """0/1 weekly schedule of a missing input ``θ_h · per_unit(t)`` at ``node``.
+
+    θ_h ≥ 0 for every hour of the three day types of building schedules (weekdays, Saturday,
+    Sunday) is the value that, passed through the fitted model's dynamics, best explains the
+    training residual (a deconvolution: the raw residual is the missing heat smeared and delayed
+    by the building's inertia), while the model's own parameters may move to undo what they had
+    absorbed. The schedule is on where the smoothed θ exceeds a share of its peak, the share
+    (0.2–0.8) whose on/off schedule explains the residual best.
+    """
+    data = ctx.data
+    tz = ctx.building.location.timezone
+    hour = day_type_hour(data.times, tz)
+    heat = np.zeros((len(data), N_DAY_TYPES * 24))
+    heat[np.arange(len(data)), hour] = per_unit
+    responses = node_responses(ctx.network, ctx.params, data, node, heat)
+    theta, _ = explain_residual(ctx.residual, responses, ctx.sensitivities)
+    # Neighbouring hours share a schedule; the mean over three damps least squares' spiky
+    # solutions (each day type's hours wrap around midnight on themselves).
+    days = theta.reshape(N_DAY_TYPES, 24)
+    smoothed = weekly_from_day_types(
+        (np.roll(days, 1, axis=1) + days + np.roll(days, -1, axis=1)) / 3.0
     )
+    options = [on_hours(smoothed, share) for share in ON_SHARES]
+    signals = np.column_stack([schedule_signal(o, data.times, tz) * per_unit for o in options])
+    on_off = node_responses(ctx.network, ctx.params, data, node, signals)
+    explained = [
+        explain_residual(ctx.residual, on_off[:, [k]], ctx.sensitivities)[1]
+        for k in range(len(options))
+    ]
+    return options[int(np.argmax(explained))]
 
 
 def ventilation_schedule(ctx: Context) -> Extension | Skipped:
@@ -212,10 +282,8 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     effect = "ventilation_schedule"
     if "vent_loss" in ctx.network.signals:
         return Skipped(effect, "the model already has a ventilation schedule")
-    delta = T_REF_C - ctx.train[T_OUT].to_numpy(dtype=float)
-    # A loss ∝ ΔT makes the model over-predict (negative innovations) in proportion to ΔT.
-    per_kelvin = np.where(delta > 2.0, -ctx.innovations / np.maximum(delta, 2.0), np.nan)
-    schedule = _learnt_schedule(ctx, per_kelvin)
+    outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - T_REF_C
+    schedule = _learnt_schedule(ctx, ctx.network.output, outdoor_excess)
     if not schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
     signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "vent": schedule.tolist()})
@@ -232,7 +300,16 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     )
     net.add_heat_input("vent_loss", net.output, "h_vent")
     detail = {"schedule": describe(schedule), "volume_m3": ctx.building.volume}
-    return Extension(effect, net, signals, ("h_vent",), (("vent_loss", net.output),), detail=detail)
+    return Extension(
+        effect,
+        net,
+        signals,
+        ("h_vent",),
+        (("vent_loss", net.output),),
+        learnt=True,
+        neutral={"h_vent": 0.0},
+        detail=detail,
+    )
 
 
 def unmetered_gains(ctx: Context) -> Extension | Skipped:
@@ -240,7 +317,7 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     effect = "unmetered_gains"
     if "sched_gains" in ctx.network.signals:
         return Skipped(effect, "the model already has an unmetered-gain schedule")
-    schedule = _learnt_schedule(ctx, ctx.innovations)
+    schedule = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)))
     if not schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of missing heat")
     signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "gains": schedule.tolist()})
@@ -257,7 +334,14 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     net.add_heat_input("sched_gains", net.output, "q_unmetered")
     detail = {"schedule": describe(schedule), "floor_area_m2": ctx.building.floor_area}
     return Extension(
-        effect, net, signals, ("q_unmetered",), (("sched_gains", net.output),), detail=detail
+        effect,
+        net,
+        signals,
+        ("q_unmetered",),
+        (("sched_gains", net.output),),
+        learnt=True,
+        neutral={"q_unmetered": 0.0},
+        detail=detail,
     )
 
 
@@ -281,7 +365,13 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     net.add_resistor("t_ground", target, "r_ground", factor=1.0 / floor)
     detail = {"node": target, "floor_area_m2": floor}
     return Extension(
-        effect, net, ctx.signals, ("r_ground",), (("t_ground", target),), detail=detail
+        effect,
+        net,
+        ctx.signals,
+        ("r_ground",),
+        (("t_ground", target),),
+        neutral={"r_ground": 50.0},
+        detail=detail,
     )
 
 
@@ -304,7 +394,15 @@ def sky_radiation(ctx: Context) -> Extension | Skipped:
     )
     net.add_heat_input("sky_delta", target, "h_sky")
     detail = {"node": target}
-    return Extension(effect, net, ctx.signals, ("h_sky",), (("sky_delta", target),), detail=detail)
+    return Extension(
+        effect,
+        net,
+        ctx.signals,
+        ("h_sky",),
+        (("sky_delta", target),),
+        neutral={"h_sky": 0.0},
+        detail=detail,
+    )
 
 
 def thermal_mass(ctx: Context) -> Extension | Skipped:
@@ -339,6 +437,7 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
         ctx.signals,
         ("c_mass_extra", "r_mass_extra"),
         structural=True,
+        neutral={"c_mass_extra": 1e3, "r_mass_extra": 5.0},
         detail={"node": node},
     )
 
@@ -383,6 +482,7 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
         ctx.signals,
         ("c_emitter", "r_emitter"),
         structural=True,
+        neutral={"c_emitter": 1e2, "r_emitter": 1e-3},
         detail={"node": "emitter"},
     )
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,22 +65,23 @@ class Fit:
         r = self.residual_train[np.isfinite(self.residual_train)]
         return float(r @ r)
 
-    def information_criteria(self) -> dict[str, float]:
-        """AIC and BIC on the training residuals with an effective sample size.
-
-        Simulation residuals are strongly autocorrelated, so n counts far fewer independent
-        errors than rows; n_eff = n (1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 autocorrelation keeps
-        the criteria from rewarding every extra parameter.
-        """
+    @property
+    def n_eff(self) -> float:
+        """Effective number of independent training errors, n (1 − ρ₁)/(1 + ρ₁) with ρ₁ the
+        lag-1 autocorrelation: simulation residuals are strongly autocorrelated, and counting
+        every row would let an information criterion reward any extra parameter."""
         r = self.residual_train[np.isfinite(self.residual_train)]
-        n = r.size
-        rho = float(np.corrcoef(r[:-1], r[1:])[0, 1]) if n > 2 and r.std() > 0 else 0.0
-        n_eff = max(10.0, n * (1.0 - rho) / (1.0 + rho)) if rho < 1 else 10.0
+        rho = float(np.corrcoef(r[:-1], r[1:])[0, 1]) if r.size > 2 and r.std() > 0 else 0.0
+        return max(10.0, r.size * (1.0 - rho) / (1.0 + rho)) if rho < 1 else 10.0
+
+    def information_criteria(self, n_eff: float) -> dict[str, float]:
+        """AIC and BIC of the training fit for ``n_eff`` independent errors; compare two models
+        with the same n_eff (the simpler model's)."""
+        n = int(np.isfinite(self.residual_train).sum())
         log_like = n_eff * np.log(max(self.sse_train / n, 1e-12))
         return {
             "aic": float(log_like + 2 * self.n_params),
             "bic": float(log_like + self.n_params * np.log(n_eff)),
-            "n_eff": float(n_eff),
         }
 
 
@@ -130,3 +132,34 @@ def fit_model(
         n_simulations=est.n_simulations_,
         split=split,
     )
+
+
+def residual_at(network: RCNetwork, params: dict[str, float], data: Dataset) -> np.ndarray:
+    """measured − simulated (initial states profiled) for given parameters. [K]"""
+    trajectory = Objective(network.compile(), data).trajectory(params)
+    return data.measured - trajectory.y
+
+
+@dataclass(frozen=True)
+class FitJob:
+    """The arguments of one ``fit_model`` call, so a batch can go to worker processes."""
+
+    network: RCNetwork
+    options: SignalOptions
+    split: Split
+    preset: str
+    random_state: int
+    warm_start: list[dict[str, float]] | None = None
+
+    def run(self) -> Fit:
+        return fit_model(
+            self.network, self.options, self.split, self.preset, self.random_state, self.warm_start
+        )
+
+
+def fit_many(jobs: list[FitJob], workers: int) -> list[Fit]:
+    """Run independent fits, on up to ``workers`` processes (1: in this process)."""
+    if workers <= 1 or len(jobs) <= 1:
+        return [job.run() for job in jobs]
+    with ProcessPoolExecutor(min(workers, len(jobs))) as pool:
+        return list(pool.map(FitJob.run, jobs))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+from pathlib import Path
 
 import matplotlib
 
@@ -24,7 +25,9 @@ img{max-width:100%}
 """
 
 
-def _png(fig: plt.Figure) -> str:
+def _png(fig: plt.Figure | None) -> str:
+    if fig is None:
+        return ""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
@@ -32,7 +35,7 @@ def _png(fig: plt.Figure) -> str:
     return f'<img alt="figure" src="data:image/png;base64,{data}">'
 
 
-def _timeseries(report: Report, days: int = 14) -> str:
+def timeseries_figure(report: Report, days: int = 14) -> plt.Figure:
     test = report.baseline.split.test
     local = test.times.tz_convert(report.building.location.timezone)
     n = min(len(test), int(days * 86400 / test.step_s))
@@ -57,10 +60,10 @@ def _timeseries(report: Report, days: int = 14) -> str:
     ax.set_title(f"Test period, first {days} days: measured vs predicted before and after")
     ax.legend(loc="upper right", fontsize=8)
     fig.autofmt_xdate()
-    return _png(fig)
+    return fig
 
 
-def _heatmaps(report: Report) -> str:
+def heatmaps_figure(report: Report) -> plt.Figure:
     tz = report.building.location.timezone
     grids = [("before: " + report.model, report.baseline)]
     if report.final is not report.baseline:
@@ -75,10 +78,10 @@ def _heatmaps(report: Report) -> str:
         ax.set_xlabel("hour of day (local)")
         ax.set_title(f"mean test residual [K], {title}", fontsize=9)
     fig.colorbar(im, ax=axes[0].tolist(), label="measured − predicted [K]")
-    return _png(fig)
+    return fig
 
 
-def _conditions(report: Report) -> str:
+def conditions_figure(report: Report) -> plt.Figure:
     block = report.locate["test"]["by_condition"]
     labels, means = [], []
     for groups in block.values():
@@ -90,13 +93,13 @@ def _conditions(report: Report) -> str:
     ax.axhline(0, color="k", lw=0.8)
     ax.set_ylabel("mean residual [K]")
     ax.set_title("Baseline test residual by condition (positive: model too cold)")
-    return _png(fig)
+    return fig
 
 
-def _evidence(report: Report, finding: Finding) -> str:
+def evidence_figure(report: Report, finding: Finding) -> plt.Figure | None:
     screen = finding.screen
     if screen is None:
-        return ""
+        return None
     train = report.baseline.split.train  # every model shares the training rows
     resid = _residual_before(report, finding)
     n = min(len(train), int(7 * 86400 / train.step_s))
@@ -118,13 +121,33 @@ def _evidence(report: Report, finding: Finding) -> str:
     a2.set_xlabel("candidate contribution [K]")
     a2.set_ylabel("residual before [K]")
     fig.autofmt_xdate()
-    return _png(fig)
+    return fig
 
 
 def _residual_before(report: Report, finding: Finding) -> np.ndarray:
     # The residual the candidate was screened against: the model of the round it was judged in.
     fits = [report.baseline] + [f.fit for f in report.accepted]
     return fits[min(finding.round - 1, len(fits) - 1)].residual_train
+
+
+def save_figures(report: Report, folder: Path, stem: str) -> list[Path]:
+    """Write the report's figures as PNG files ``<stem>_<figure>.png``; returns their paths."""
+    figures = {
+        "timeseries": timeseries_figure(report),
+        "heatmaps": heatmaps_figure(report),
+        "conditions": conditions_figure(report),
+    }
+    if report.accepted:
+        figures["evidence"] = evidence_figure(report, report.accepted[0])
+    paths = []
+    for name, fig in figures.items():
+        if fig is None:
+            continue
+        path = folder / f"{stem}_{name}.png"
+        fig.savefig(path, dpi=80, bbox_inches="tight")
+        plt.close(fig)
+        paths.append(path)
+    return paths
 
 
 def render(report: Report) -> str:
@@ -143,7 +166,7 @@ def render(report: Report) -> str:
     )
     skipped = "".join(f"<li><b>{esc(k)}</b>: {esc(v)}</li>" for k, v in d["skipped"].items())
     evidence = "".join(
-        f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_evidence(report, f)}"
+        f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_png(evidence_figure(report, f))}"
         for f in report.accepted
     )
     white = d["whiteness"]
@@ -157,8 +180,9 @@ train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
 Training {esc(d["periods"]["train"][0][:10])} – {esc(d["periods"]["train"][1][:10])},
 test until {esc(d["periods"]["test"][1][:10])}.</p>
 <p>Where and when: {esc(d["mismatch"]["summary"])}.</p></div>
-<h2>Measured vs predicted</h2>{_timeseries(report)}
-<h2>Where the errors concentrate</h2>{_heatmaps(report)}{_conditions(report)}
+<h2>Measured vs predicted</h2>{_png(timeseries_figure(report))}
+<h2>Where the errors concentrate</h2>{_png(heatmaps_figure(report))}
+{_png(conditions_figure(report))}
 <h2>Findings</h2><table><tr><th>effect</th><th>verdict</th><th>screening</th>
 <th>test RMSE before [K]</th><th>after [K]</th><th>ΔBIC</th><th>reason</th></tr>{rows}</table>
 <h2>Evidence for accepted findings</h2>{evidence or "<p>None accepted.</p>"}

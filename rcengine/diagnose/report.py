@@ -82,13 +82,17 @@ def judge(
 ) -> Finding:
     """Accept an extension only for a meaningful test improvement that the BIC confirms."""
     before, after = current.rmse_test, fit.rmse_test
-    ic_before, ic_after = current.information_criteria(), fit.information_criteria()
+    n_eff = current.n_eff
+    ic_before, ic_after = current.information_criteria(n_eff), fit.information_criteria(n_eff)
     delta_bic = ic_after["bic"] - ic_before["bic"]
     new = {p: fit.params[p] for p in ext.new_parameters}
     bounds = [p for p in fit.at_bounds if p in ext.new_parameters]
-    lower = {p: ext.network.parameters[p].lower for p in ext.new_parameters}
-    idle = all(np.isclose(v, lower[p], rtol=1e-3, atol=1e-9) for p, v in new.items()) and not (
-        ext.structural
+    # Idle: every new parameter whose neutral value is its lower bound (a gain, a capacity) sits
+    # there, so whatever the refit improved came from re-fitting the old parameters.
+    lower = {p: ext.network.parameters[p].lower for p in ext.neutral}
+    gains = [p for p, v in ext.neutral.items() if v == lower[p]]
+    idle = bool(gains) and all(
+        np.isclose(fit.params[p], lower[p], rtol=1e-3, atol=1e-9) for p in gains
     )
     gain = before - after
     checks = [

@@ -21,9 +21,9 @@ from ..estimate import Estimator, EstimatorSettings
 from ..exceptions import ConvergenceWarning
 from ..ga import GASettings
 from ..pattern_search import GPSSettings
-from ..simulate import simulate
 from .candidates import Extension
 from .fitting import Fit, Split
+from .response import node_responses
 
 LOCAL_REFIT = EstimatorSettings(
     GASettings(population=16, generations=4, lhs=True),
@@ -52,29 +52,15 @@ def screen(ext: Extension, base: Fit, split: Split, random_state: int) -> Screen
 
 
 def _projection(ext: Extension, base: Fit, train: Dataset) -> Screen:
-    probe = base.network.copy("probe")
     measured = _filled(train.measured)
-    heat_signals = []
+    columns = []
     for signal, node in ext.inputs:
+        heat = train.frame[signal].to_numpy(dtype=float)
         if signal in ext.network.temperatures:
             # A resistor to a new boundary adds (T_b − T_node)/R; near the fitted model the node
             # sits close to the measured indoor temperature.
-            heat = train.frame[signal].to_numpy(dtype=float) - measured
-        else:
-            heat = train.frame[signal].to_numpy(dtype=float)
-        name = f"probe_{len(heat_signals)}"
-        probe.add_heat_input(name, node)
-        heat_signals.append((name, heat))
-    compiled = probe.compile()
-    rc = compiled.rc_matrices(base.params)
-    columns = []
-    for name, heat in heat_signals:
-        u = np.zeros((len(train), compiled.n_inputs))
-        u[:, compiled.input_names.index(name)] = heat
-        y = np.empty(len(train))
-        for seg in train.segments:
-            y[seg] = simulate(rc, u[seg], np.zeros((1, compiled.n_states)), train.step_s)[0]
-        columns.append(y)
+            heat = heat - measured
+        columns.append(node_responses(base.network, base.params, train, node, heat)[:, 0])
     mask = np.isfinite(base.residual_train)
     Y = np.column_stack(columns)
     r = base.residual_train
@@ -92,7 +78,7 @@ def _local_refit(ext: Extension, base: Fit, split: Split, random_state: int) -> 
             ext.network,
             preset=LOCAL_REFIT,
             random_state=random_state,
-            warm_start=[dict(base.params)],
+            warm_start=[{**base.params, **ext.neutral}, dict(base.params)],
         ).fit(split.train)
     y = split.train.measured
     resid = y - est.trajectory_.y
