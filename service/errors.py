@@ -31,3 +31,7 @@ class NoParameterSetError(ConflictError):
 
 class CalibrationError(ServiceError):
     """A calibration cannot run on the stored data (too little data, gaps, ...)."""
+
+
+class DiagnosisError(ServiceError):
+    """A diagnosis cannot run on the stored data (too little measured data in its window)."""

@@ -1,18 +1,24 @@
-"""Calibration jobs: create, hand to the executor, recover after a restart, nightly batch."""
+"""Jobs (calibrations and diagnoses): create, hand to the executor, recover after a restart,
+nightly batch."""
 
 from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable
 from concurrent.futures import Executor, Future
 from concurrent.futures.process import BrokenProcessPool
+from typing import Any
 
-from . import repository
-from .calibration import CalibrationOptions, describe, execute, run_job
+from sqlalchemy.orm import Session
+
+from . import calibration, diagnosis, repository
+from .calibration import CalibrationOptions, describe, execute
 from .core.config import Settings
 from .core.db import Database
+from .diagnosis import DiagnosisOptions, DiagnosisSpec
 from .errors import ConflictError
-from .models import ACTIVE_JOB_STATUSES, FAILED, JobRecord
+from .models import ACTIVE_JOB_STATUSES, CALIBRATION, DIAGNOSIS, FAILED, BuildingRecord, JobRecord
 from .pool import make_executor, warm_up
 
 log = logging.getLogger(__name__)
@@ -20,34 +26,65 @@ INTERRUPTED = "interrupted: the server stopped before the job finished"
 
 
 class JobRunner:
-    """Owns the executor; ``create`` queues a job and hands it over at once."""
+    """Owns the executor; ``create`` and ``create_diagnosis`` queue a job and hand it over at
+    once. One executor runs both kinds."""
 
     def __init__(self, settings: Settings, db: Database):
         self.settings = settings
         self.db = db
         self.options = options_of(settings)
+        # The worker entry of each kind of job and the settings it receives.
+        self._entries: dict[str, tuple[Callable[..., None], Any]] = {
+            CALIBRATION: (calibration.run_job, self.options),
+            DIAGNOSIS: (diagnosis.run_job, diagnosis_options_of(settings)),
+        }
         self._lock = threading.Lock()
         self._executor = self._new_executor()
 
     def create(self, building_id: int, model: str, days: int, trigger: str) -> JobRecord:
-        """Queue a job and submit it; ConflictError if the building has one active or has no
-        measured data yet."""
+        """Queue a calibration and submit it; ConflictError if the building has one active or
+        has no measured data yet."""
         with self.db.write() as session:
-            if repository.get_building(session, building_id).last_measured_at is None:
-                raise ConflictError(
-                    f"building {building_id} has no measured t_in yet; upload measurements first"
-                )
+            _measured_building(session, building_id)
             job = repository.add_job(session, building_id, trigger, model, days)
         self.submit(job.id)
         return job
 
-    def submit(self, job_id: int) -> None:
+    def create_diagnosis(
+        self, building_id: int, model: str, spec: DiagnosisSpec, trigger: str
+    ) -> JobRecord:
+        """Queue a diagnosis of the window ``spec`` asks for and submit it; ConflictError if
+        the building has one active or has no measured data yet."""
+        with self.db.write() as session:
+            building = _measured_building(session, building_id)
+            _, first_stored, _ = repository.measurement_summary(session, building_id)
+            job_plan = diagnosis.plan(
+                spec,
+                first_stored,
+                building.last_measured_at,
+                building.step_s,
+                self.settings.diagnosis_days,
+            )
+            job = repository.add_job(
+                session,
+                building_id,
+                trigger,
+                model,
+                job_plan.days,
+                DIAGNOSIS,
+                job_plan.to_dict(),
+            )
+        self.submit(job.id, DIAGNOSIS)
+        return job
+
+    def submit(self, job_id: int, kind: str = CALIBRATION) -> None:
+        entry, options = self._entries[kind]
         try:
-            future = self._executor.submit(run_job, self.db.url, job_id, self.options)
+            future = self._executor.submit(entry, self.db.url, job_id, options)
         except BrokenProcessPool:  # a worker died (killed, out of memory): start a new pool
             with self._lock:
                 self._executor = self._new_executor()
-            future = self._executor.submit(run_job, self.db.url, job_id, self.options)
+            future = self._executor.submit(entry, self.db.url, job_id, options)
         future.add_done_callback(lambda f: self._finished(job_id, f))
 
     def shutdown(self) -> None:
@@ -65,7 +102,7 @@ class JobRunner:
             job = repository.get_job(session, job_id)
             if job.status in ACTIVE_JOB_STATUSES:
                 repository.finish_job(session, job_id, FAILED, error=reason)
-        log.error("calibration job ended abnormally", extra={"job_id": job_id, "error": reason})
+        log.error("job ended abnormally", extra={"job_id": job_id, "error": reason})
 
     def _new_executor(self) -> Executor:
         executor = make_executor(self.settings.workers, self.settings.log_level)
@@ -76,6 +113,19 @@ class JobRunner:
 
 def options_of(settings: Settings) -> CalibrationOptions:
     return CalibrationOptions(preset=settings.preset, random_state=settings.random_state)
+
+
+def diagnosis_options_of(settings: Settings) -> DiagnosisOptions:
+    return DiagnosisOptions(preset=settings.diagnosis_preset, random_state=settings.random_state)
+
+
+def _measured_building(session: Session, building_id: int) -> BuildingRecord:
+    building = repository.get_building(session, building_id)
+    if building.last_measured_at is None:
+        raise ConflictError(
+            f"building {building_id} has no measured t_in yet; upload measurements first"
+        )
+    return building
 
 
 def fail_interrupted(db: Database) -> list[int]:

@@ -1,5 +1,5 @@
 """The app factory: ``create_app(settings)`` builds an app whose lifespan owns the database
-engine, the calibration executor and the scheduler; nothing is created at import time."""
+engine, the job executor and the scheduler; nothing is created at import time."""
 
 from __future__ import annotations
 
@@ -34,6 +34,8 @@ Calibrated grey-box RC thermal models of buildings for Model Predictive Control.
 3. `POST /buildings/{id}/calibrations`, poll `GET /jobs/{job_id}`; a nightly job re-fits every
    building with new data.
 4. `GET /buildings/{id}/forecast`, `POST /buildings/{id}/simulate`, `GET /buildings/{id}/model`.
+5. `POST /buildings/{id}/diagnoses`, then `GET /buildings/{id}/diagnosis` (JSON or HTML): where
+   the model misses the measurements and which physics it lacks.
 
 Every call but `/health` needs `Authorization: Bearer <token>`.
 """
@@ -41,7 +43,9 @@ Every call but `/health` needs `Authorization: Bearer <token>`.
 TAGS = [
     {"name": "buildings", "description": "Register buildings and read their state."},
     {"name": "measurements", "description": "Upload and read time series (CONTRACT.md §1)."},
-    {"name": "calibrations", "description": "Re-estimate parameters; poll the jobs."},
+    {"name": "calibrations", "description": "Re-estimate parameters."},
+    {"name": "diagnoses", "description": "Mismatch diagnosis: the physics the model lacks."},
+    {"name": "jobs", "description": "Poll calibration and diagnosis jobs."},
     {"name": "parameters", "description": "Parameter sets with their fit metrics."},
     {"name": "forecast", "description": "Forecasts, trajectories and the model for an MPC."},
     {"name": "health", "description": "Liveness."},

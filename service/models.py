@@ -32,6 +32,8 @@ from rcengine.columns import NUMERIC_COLUMNS, TIME
 QUEUED, RUNNING, SUCCEEDED, FAILED = "queued", "running", "succeeded", "failed"
 ACTIVE_JOB_STATUSES = (QUEUED, RUNNING)
 PROMOTED, REJECTED = "promoted", "rejected"
+# What a job does: re-estimate the parameters, or diagnose the model-data mismatch.
+CALIBRATION, DIAGNOSIS = "calibration", "diagnosis"
 # Parameter-set status: the one in use, one it replaced, or one that lost on the held-out day.
 CURRENT, SUPERSEDED = "current", "superseded"
 
@@ -103,12 +105,15 @@ measurements = Table(
 
 
 class JobRecord(Base):
-    """A calibration: queued → running → succeeded | failed; ``outcome`` says promoted or not."""
+    """A calibration or a diagnosis: queued → running → succeeded | failed; a calibration's
+    ``outcome`` says whether its set was promoted. ``days``: days fitted (calibration) or days
+    diagnosed; ``options``: what a diagnosis was asked (window, train fraction, effects)."""
 
     __tablename__ = "jobs"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
+    kind: Mapped[str] = mapped_column(String(16), default=CALIBRATION, server_default=CALIBRATION)
     status: Mapped[str] = mapped_column(String(16), default=QUEUED)
     outcome: Mapped[str | None] = mapped_column(String(16))
     trigger: Mapped[str] = mapped_column(String(16))
@@ -120,12 +125,14 @@ class JobRecord(Base):
     finished_at: Mapped[datetime | None]
     error: Mapped[str | None] = mapped_column(Text)
     details: Mapped[dict[str, Any] | None] = mapped_column(JSON)
+    options: Mapped[dict[str, Any] | None] = mapped_column(JSON)
 
     __table_args__ = (
-        # At most one queued or running job per building, enforced by the database.
+        # At most one queued or running job of each kind per building, enforced by the database.
         Index(
-            "uq_jobs_active_building",
+            "uq_jobs_active_building_kind",
             "building_id",
+            "kind",
             unique=True,
             sqlite_where=text("status IN ('queued', 'running')"),
             postgresql_where=text("status IN ('queued', 'running')"),
@@ -165,6 +172,29 @@ class ParameterSetRecord(Base):
         ),
         Index("ix_parameter_sets_building_created", "building_id", "created_at"),
     )
+
+
+class DiagnosisRecord(Base):
+    """A finished diagnosis: the CONTRACT.md §3 report, its HTML page and what was diagnosed."""
+
+    __tablename__ = "diagnoses"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
+    job_id: Mapped[int | None] = mapped_column(ForeignKey("jobs.id", ondelete="SET NULL"))
+    model: Mapped[str] = mapped_column(String(100))
+    # First and one-past-last time of the rows diagnosed.
+    window_start: Mapped[datetime]
+    window_end: Mapped[datetime]
+    # The engine settings of the run: preset, random_state, train_fraction, effects.
+    settings: Mapped[dict[str, Any]]
+    report: Mapped[dict[str, Any]]
+    # Hundreds of kB: loaded only when the HTML page is asked for.
+    html: Mapped[str] = mapped_column(Text, deferred=True)
+    engine_version: Mapped[str] = mapped_column(String(32))
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+    __table_args__ = (Index("ix_diagnoses_building_created", "building_id", "created_at"),)
 
 
 class AdminTokenRecord(Base):

@@ -1,4 +1,4 @@
-"""The executor that runs calibrations off the request path.
+"""The executor that runs jobs (calibrations, diagnoses) off the request path.
 
 Worker processes are started with ``spawn`` (no copy of the server's threads, locks or database
 connections), at low CPU priority so that the API answers first when both want a core, and with
@@ -21,7 +21,7 @@ _THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS
 def make_executor(workers: int, log_level: str) -> Executor:
     """``workers`` spawned processes, or one thread of this process when ``workers`` is 0."""
     if workers == 0:
-        return ThreadPoolExecutor(max_workers=1, thread_name_prefix="calibration")
+        return ThreadPoolExecutor(max_workers=1, thread_name_prefix="job")
     return ProcessPoolExecutor(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
@@ -32,7 +32,7 @@ def make_executor(workers: int, log_level: str) -> Executor:
 
 def warm_up() -> None:
     """Import the engine in a worker ahead of the first job."""
-    import service.calibration  # noqa: F401
+    from . import calibration, diagnosis  # noqa: F401
 
 
 def _init_worker(log_level: str) -> None:

@@ -21,6 +21,7 @@ from rcengine.columns import TIME
 from .errors import ConflictError, NotFoundError
 from .models import (
     ACTIVE_JOB_STATUSES,
+    CALIBRATION,
     CURRENT,
     FAILED,
     QUEUED,
@@ -29,6 +30,7 @@ from .models import (
     SUPERSEDED,
     AdminTokenRecord,
     BuildingRecord,
+    DiagnosisRecord,
     JobRecord,
     ParameterSetRecord,
     measurements,
@@ -138,34 +140,47 @@ def measurement_summary(
 
 
 # --- jobs -------------------------------------------------------------------------------------
-def add_job(session: Session, building_id: int, trigger: str, model: str, days: int) -> JobRecord:
-    """A queued job; ConflictError when the building already has one queued or running."""
-    active = active_job(session, building_id)
+def add_job(
+    session: Session,
+    building_id: int,
+    trigger: str,
+    model: str,
+    days: int,
+    kind: str = CALIBRATION,
+    options: dict[str, Any] | None = None,
+) -> JobRecord:
+    """A queued job; ConflictError when the building already has one of this kind queued or
+    running."""
+    active = active_job(session, building_id, kind)
     if active is not None:
         raise ConflictError(
-            f"building {building_id} already has calibration job {active.id} {active.status}; "
+            f"building {building_id} already has {kind} job {active.id} {active.status}; "
             f"poll GET /jobs/{active.id}"
         )
     building = get_building(session, building_id)
     job = JobRecord(
         building_id=building_id,
+        kind=kind,
         status=QUEUED,
         trigger=trigger,
         model=model,
         days=days,
         data_revision=building.data_revision,
+        options=options,
     )
     try:
         with session.begin_nested():
             session.add(job)
     except IntegrityError as exc:  # another process queued one between the check and now
-        raise ConflictError(f"building {building_id} already has an active calibration") from exc
+        raise ConflictError(f"building {building_id} already has an active {kind}") from exc
     return job
 
 
-def active_job(session: Session, building_id: int) -> JobRecord | None:
+def active_job(session: Session, building_id: int, kind: str = CALIBRATION) -> JobRecord | None:
     query = select(JobRecord).where(
-        JobRecord.building_id == building_id, JobRecord.status.in_(ACTIVE_JOB_STATUSES)
+        JobRecord.building_id == building_id,
+        JobRecord.kind == kind,
+        JobRecord.status.in_(ACTIVE_JOB_STATUSES),
     )
     return session.scalars(query).first()
 
@@ -177,10 +192,12 @@ def get_job(session: Session, job_id: int) -> JobRecord:
     return job
 
 
-def list_jobs(session: Session, building_id: int, limit: int) -> Sequence[JobRecord]:
+def list_jobs(
+    session: Session, building_id: int, limit: int, kind: str = CALIBRATION
+) -> Sequence[JobRecord]:
     query = (
         select(JobRecord)
-        .where(JobRecord.building_id == building_id)
+        .where(JobRecord.building_id == building_id, JobRecord.kind == kind)
         .order_by(JobRecord.id.desc())
         .limit(limit)
     )
@@ -224,6 +241,7 @@ def buildings_with_new_data(session: Session) -> list[int]:
     """Buildings whose data changed since their last calibration job (or that never had one)."""
     last_job = (
         select(JobRecord.building_id, func.max(JobRecord.data_revision).label("revision"))
+        .where(JobRecord.kind == CALIBRATION)
         .group_by(JobRecord.building_id)
         .subquery()
     )
@@ -306,6 +324,22 @@ def forecast_key(session: Session | Connection, building_id: int) -> Row:
     if row is None:
         raise NotFoundError(f"building {building_id} not found")
     return row
+
+
+# --- diagnoses --------------------------------------------------------------------------------
+def add_diagnosis(session: Session, record: DiagnosisRecord) -> DiagnosisRecord:
+    session.add(record)
+    session.flush()
+    return record
+
+
+def latest_diagnosis(session: Session, building_id: int) -> DiagnosisRecord | None:
+    query = (
+        select(DiagnosisRecord)
+        .where(DiagnosisRecord.building_id == building_id)
+        .order_by(DiagnosisRecord.id.desc())
+    )
+    return session.scalars(query).first()
 
 
 # --- admin token ------------------------------------------------------------------------------

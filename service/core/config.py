@@ -46,13 +46,23 @@ class Settings(BaseSettings):
     model: str = Field("basic", description="Default model of the rcengine library.")
     preset: str = Field("default", description="Estimator preset of rcengine.estimate.")
     random_state: int = 0
+    diagnosis_days: int = Field(
+        182,
+        ge=2,
+        le=3660,
+        description="Days of record a diagnosis covers by default, ending at the last measured "
+        "t_in (clipped to the stored data).",
+    )
+    diagnosis_preset: str = Field(
+        "default", description="Estimator preset of every fit of a diagnosis."
+    )
     max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="Request size limit.")
     workers: int = Field(
         1,
         ge=0,
         le=64,
-        description="Calibration worker processes; 0 runs calibrations on a thread of the "
-        "server process (tests, tiny deployments).",
+        description="Worker processes for jobs (calibrations, diagnoses); 0 runs them on a "
+        "thread of the server process (tests, tiny deployments).",
     )
     forecast_cache_size: int = Field(512, ge=0, description="Forecasts kept in memory.")
     log_level: str = "INFO"
@@ -73,7 +83,7 @@ class Settings(BaseSettings):
             raise ValueError(f"invalid model {value!r}; choose from {sorted(MODELS)}")
         return value
 
-    @field_validator("preset")
+    @field_validator("preset", "diagnosis_preset")
     @classmethod
     def _known_preset(cls, value: str) -> str:
         if value not in PRESETS:

@@ -1,8 +1,25 @@
-"""Bodies shared by every resource: errors."""
+"""Bodies shared by every resource: errors, model names."""
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field
+from typing import Annotated
+
+from pydantic import AfterValidator, BaseModel, Field
+
+from rcengine.models import MODELS
+
+
+def _known_model(name: str | None) -> str | None:
+    if name is not None and name not in MODELS:
+        raise ValueError(f"invalid model {name!r}; choose from {sorted(MODELS)}")
+    return name
+
+
+ModelName = Annotated[
+    str | None,
+    AfterValidator(_known_model),
+    Field(description="Model of the rcengine library (default: RCSERVICE_MODEL, basic)"),
+]
 
 
 class ProblemRead(BaseModel):

@@ -1,0 +1,265 @@
+"""A diagnosis job: the engine's mismatch diagnosis (``rcengine.diagnose``) on a window of the
+stored measurements, its report (CONTRACT.md §3 JSON and the HTML page) stored for the building.
+
+The window is fixed when the job is queued (:func:`plan`)::
+
+    |<------ train_fraction: fitted ------>|<------ the rest: tested ------>|
+    start                                                end = last measured t_in + one step
+
+By default it covers ``diagnosis_days`` before ``end``, clipped to the stored rows; the engine
+splits it at a local midnight. A job that raises is stored failed with its error and adds no
+report, so the previous report stays the building's latest.
+
+``run_job`` is the entry point of the worker process; ``execute`` runs a job in the caller's
+process (the server when ``RCSERVICE_WORKERS=0``).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Any
+
+import pandas as pd
+
+from rcengine import __version__
+from rcengine.building import Building
+from rcengine.columns import T_IN
+from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.exceptions import DataValidationError, Problem, RCEngineError
+
+from . import bridge, repository
+from .calibration import describe
+from .core.db import Database
+from .errors import DiagnosisError
+from .models import FAILED, SUCCEEDED, DiagnosisRecord
+
+# Measured data a diagnosis needs at least: whole days to fit and whole days to test. [d]
+MIN_DIAGNOSIS_DAYS = 2
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class DiagnosisOptions:
+    """Service-wide engine settings passed to the worker (picklable)."""
+
+    preset: str = "default"
+    random_state: int = 0
+
+
+@dataclass(frozen=True)
+class DiagnosisSpec:
+    """What a client asked for: ``days`` before ``end`` or the window from ``start``; None
+    leaves the choice to the service (window) or the engine (train_fraction, effects)."""
+
+    days: int | None = None
+    start: pd.Timestamp | None = None
+    end: pd.Timestamp | None = None
+    train_fraction: float | None = None
+    effects: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class DiagnosisPlan:
+    """The window (UTC) a job diagnoses and the engine choices it was asked for; stored as the
+    job's ``options``."""
+
+    start: pd.Timestamp
+    end: pd.Timestamp
+    train_fraction: float | None
+    effects: tuple[str, ...] | None
+
+    @property
+    def days(self) -> int:
+        return math.ceil((self.end - self.start) / pd.Timedelta(days=1))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "start": self.start.isoformat(),
+            "end": self.end.isoformat(),
+            "train_fraction": self.train_fraction,
+            "effects": None if self.effects is None else list(self.effects),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DiagnosisPlan:
+        effects = data.get("effects")
+        return cls(
+            pd.Timestamp(data["start"]),
+            pd.Timestamp(data["end"]),
+            data.get("train_fraction"),
+            None if effects is None else tuple(effects),
+        )
+
+
+def plan(
+    spec: DiagnosisSpec,
+    first_stored: datetime,
+    last_measured: datetime,
+    step_s: float,
+    default_days: int,
+) -> DiagnosisPlan:
+    """The window of ``spec`` clipped to the stored rows up to the last measured ``t_in``.
+
+    Raises
+    ------
+    DataValidationError : naming ``start`` or ``end`` when the window holds no measured row.
+    """
+    measured_end = pd.Timestamp(last_measured) + pd.Timedelta(seconds=step_s)
+    end = measured_end if spec.end is None else min(spec.end, measured_end)
+    days = pd.Timedelta(days=spec.days or default_days)
+    start = max(end - days if spec.start is None else spec.start, pd.Timestamp(first_stored))
+    if end <= start:
+        raise DataValidationError(
+            [
+                Problem(
+                    None,
+                    "start" if spec.start is not None else "end",
+                    f"the window {start.isoformat()} to {end.isoformat()} holds no measured "
+                    f"data: rows are stored from {pd.Timestamp(first_stored).isoformat()}, "
+                    f"t_in until {pd.Timestamp(last_measured).isoformat()}",
+                )
+            ]
+        )
+    return DiagnosisPlan(start, end, spec.train_fraction, spec.effects)
+
+
+def run_job(database_url: str, job_id: int, options: DiagnosisOptions) -> None:
+    """Worker entry: its own database engine, then :func:`execute`."""
+    db = Database(database_url)
+    try:
+        execute(db, job_id, options)
+    finally:
+        db.dispose()
+
+
+def execute(db: Database, job_id: int, options: DiagnosisOptions) -> str:
+    """Run a queued diagnosis to its end; returns its final status. Never raises for a failed
+    diagnosis."""
+    started = time.perf_counter()
+    with db.write() as session:
+        job = repository.start_job(session, job_id)
+        building_id, model = job.building_id, job.model
+        job_plan = DiagnosisPlan.from_dict(job.options)
+    context = {"job_id": job_id, "building_id": building_id}
+    log.info("diagnosis started", extra=context)
+    try:
+        record = diagnose_building(
+            db,
+            building_id,
+            model,
+            job_plan,
+            options,
+            lambda step: log.info("diagnosis progress", extra={**context, "step": step}),
+        )
+    except Exception as exc:  # stored with its reason; the previous report stays the latest
+        error = describe(exc)
+        with db.write() as session:
+            repository.finish_job(session, job_id, FAILED, error=error)
+        log.warning(
+            "diagnosis failed",
+            extra={**context, "error": error},
+            exc_info=not isinstance(exc, RCEngineError | DiagnosisError),
+        )
+        return FAILED
+    record.job_id = job_id
+    with db.write() as session:
+        repository.add_diagnosis(session, record)
+        details = _details(record, time.perf_counter() - started)
+        repository.finish_job(session, job_id, SUCCEEDED, details=details)
+    log.info(
+        "diagnosis finished",
+        extra={**context, "diagnosis_id": record.id, "accepted": details["accepted"]},
+    )
+    return SUCCEEDED
+
+
+def diagnose_building(
+    db: Database,
+    building_id: int,
+    model: str,
+    job_plan: DiagnosisPlan,
+    options: DiagnosisOptions,
+    progress: Callable[[str], None],
+) -> DiagnosisRecord:
+    """Diagnose the planned window of the stored rows; the report as an unsaved row."""
+    with db.session() as session:
+        row = repository.get_building(session, building_id)
+        building, step_s = bridge.building_of(row.description), row.step_s
+        frame = bridge.load_frame(session, building_id, job_plan.start, job_plan.end)
+    _check_enough(frame, job_plan, step_s)
+    settings = engine_settings(job_plan, options)
+    report, page = diagnose_frame(frame, building, model, settings, progress)
+    return DiagnosisRecord(
+        building_id=building_id,
+        model=model,
+        window_start=bridge.to_datetime(frame.index[0]),
+        window_end=bridge.to_datetime(frame.index[-1] + pd.Timedelta(seconds=step_s)),
+        settings={
+            "preset": settings.preset,
+            "random_state": settings.random_state,
+            "train_fraction": settings.train_fraction,
+            "effects": list(settings.effects),
+        },
+        report=report,
+        html=page,
+        engine_version=__version__,
+    )
+
+
+def engine_settings(job_plan: DiagnosisPlan, options: DiagnosisOptions) -> DiagnoseSettings:
+    """The service's preset and seed, and the job's choices where it made any."""
+    chosen = {"train_fraction": job_plan.train_fraction, "effects": job_plan.effects}
+    return DiagnoseSettings(
+        preset=options.preset,
+        random_state=options.random_state,
+        **{name: value for name, value in chosen.items() if value is not None},
+    )
+
+
+def diagnose_frame(
+    frame: pd.DataFrame,
+    building: Building,
+    model: str,
+    settings: DiagnoseSettings,
+    progress: Callable[[str], None],
+) -> tuple[dict[str, Any], str]:
+    """The engine's diagnosis: the CONTRACT.md §3 report (JSON values) and its HTML page."""
+    # Imported here: matplotlib is needed only in the process that renders a report.
+    from rcengine.diagnose.html import render
+
+    report = diagnose(frame, building, model, settings, progress)
+    return json.loads(report.to_json()), render(report)
+
+
+def _check_enough(frame: pd.DataFrame, job_plan: DiagnosisPlan, step_s: float) -> None:
+    measured = int(frame[T_IN].notna().sum()) if T_IN in frame else 0
+    if measured * step_s < MIN_DIAGNOSIS_DAYS * 86400.0:
+        raise DiagnosisError(
+            f"not enough measured data: a diagnosis needs at least {MIN_DIAGNOSIS_DAYS} days of "
+            f"measured t_in (whole days to fit, whole days to test); found {measured} row(s) "
+            f"in {job_plan.start.isoformat()}–{job_plan.end.isoformat()}"
+        )
+
+
+def _details(record: DiagnosisRecord, duration_s: float) -> dict[str, Any]:
+    report = record.report
+    return {
+        "diagnosis_id": record.id,
+        "window": {
+            "start": pd.Timestamp(record.window_start).isoformat(),
+            "end": pd.Timestamp(record.window_end).isoformat(),
+        },
+        "accepted": [f["effect"] for f in report["findings"] if f["accepted"]],
+        "rmse_test": {
+            "baseline": report["baseline"]["rmse_test"],
+            "final": report["final"]["rmse_test"],
+        },
+        "final_model": report["final"]["model"],
+        "duration_s": round(duration_s, 3),
+    }
