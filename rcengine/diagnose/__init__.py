@@ -270,7 +270,7 @@ def _round(
     )
     refit, fits = _refine(frame, building, boundary, current, refit, fits, settings, say)
     confirmed = [
-        judge(e, current, fit, screens[e.effect], round_no, settings)
+        judge(e, current, fit, screens[e.effect], round_no, settings, building)
         for e, fit in zip(refit, fits, strict=True)
     ]
     for ext in ranked[n_refit:]:

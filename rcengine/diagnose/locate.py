@@ -111,12 +111,18 @@ def worst_days(resid: np.ndarray, frame: pd.DataFrame, timezone: str, count: int
     ]
 
 
-def _verb(mean: float) -> str:
-    return "under-predicts" if mean > 0 else "over-predicts"
+RESIDUAL_WORDS = ("the model", "under-predicts", "over-predicts")
 
 
-def summarize(resid: np.ndarray, frame: pd.DataFrame, building: Building) -> dict:
-    """The mismatch block of the report for one residual series."""
+def summarize(
+    resid: np.ndarray,
+    frame: pd.DataFrame,
+    building: Building,
+    words_for: tuple[str, str, str] = RESIDUAL_WORDS,
+) -> dict:
+    """The mismatch block of the report for one residual series (or, with other ``words_for``
+    = (subject, verb if positive, verb if negative), any other series in kelvin)."""
+    subject, rises, falls = words_for
     tz = building.location.timezone
     grid = hour_weekday(resid, frame.index, tz)
     profile = np.nanmean(grid, axis=0)
@@ -129,7 +135,8 @@ def summarize(resid: np.ndarray, frame: pd.DataFrame, building: Building) -> dic
     window = hour_window(profile)
     if window is not None:
         start, end, mean = window
-        words.append(f"{_verb(mean)} {start:02d}:00–{end:02d}:00 by {abs(mean):.2f} K on average")
+        verb = rises if mean > 0 else falls
+        words.append(f"{verb} {start:02d}:00–{end:02d}:00 by {abs(mean):.2f} K on average")
     contrasts = []
     for _name, (a, b, _ma, _mb) in cond.items():
         sa, sb = by_condition[_name][a], by_condition[_name][b]
@@ -145,7 +152,7 @@ def summarize(resid: np.ndarray, frame: pd.DataFrame, building: Building) -> dic
         words.append(f"overall bias {overall:+.2f} K")
     summary = "; ".join(words) if words else "no notable pattern in the errors"
     return {
-        "summary": f"the model {summary}" if words else summary,
+        "summary": f"{subject} {summary}" if words else summary,
         "mean_residual_K": overall,
         "hour_of_day_mean_K": profile.tolist(),
         "hour_weekday_mean_K": grid.tolist(),

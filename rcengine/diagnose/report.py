@@ -11,6 +11,7 @@ import pandas as pd
 from ..building import Building
 from .candidates import Extension
 from .fitting import Fit
+from .locate import summarize
 from .screen import Screen
 
 # What each effect means, in the words of the report.
@@ -78,7 +79,13 @@ class Finding:
 
 
 def judge(
-    ext: Extension, current: Fit, fit: Fit, screened: Screen, round_no: int, settings
+    ext: Extension,
+    current: Fit,
+    fit: Fit,
+    screened: Screen,
+    round_no: int,
+    settings,
+    building: Building,
 ) -> Finding:
     """Accept an extension only for a meaningful test improvement that the BIC confirms."""
     before, after = current.rmse_test, fit.rmse_test
@@ -110,6 +117,17 @@ def judge(
         if accepted
         else "rejected: " + "; ".join(failed)
     )
+    detail = dict(ext.detail)
+    detail["correction"] = summarize(
+        fit.simulated_train - current.simulated_train,
+        fit.split.train.frame,
+        building,
+        ("adding it", "raises the prediction", "lowers the prediction"),
+    )["summary"]
+    detail["peak_input"] = {
+        signal: float(np.nanmax(np.abs(fit.split.train.frame[signal].to_numpy(dtype=float))))
+        for signal, _ in ext.inputs
+    }
     return Finding(
         effect=ext.effect,
         accepted=accepted,
@@ -125,7 +143,7 @@ def judge(
         parameters=new,
         at_bounds=bounds,
         reason=reason,
-        detail=dict(ext.detail),
+        detail=detail,
         screen=screened,
         fit=fit,
     )
@@ -155,41 +173,56 @@ def _values(finding: Finding) -> str:
 
 
 def explain(finding: Finding, pattern: str) -> str:
-    """Plain words: what physics was left out, the evidence, and what adding it changed."""
+    """Plain words: what physics was left out, where and when, the evidence, what adding it did."""
     what = MISSING.get(finding.effect, finding.effect)
-    evidence = (
-        f"its own input, passed through the model's dynamics, explains "
-        f"{max(finding.screen_explained, 0.0):.0%} of the training error"
-        if finding.screen_method == "projection"
-        else f"a short refit with it removes {max(finding.screen_explained, 0.0):.0%} of the "
-        "training error"
-    )
     facts = _facts(finding)
     if finding.rmse_test_after is None:
+        evidence = (
+            f"its own input, passed through the model's dynamics, explains "
+            f"{max(finding.screen_explained, 0.0):.0%} of the training error"
+            if finding.screen_method == "projection"
+            else f"a short refit with it removes {max(finding.screen_explained, 0.0):.0%} of the "
+            "training error"
+        )
         return f"Candidate: {what}. Screening only: {evidence}{facts}."
-    change = (
-        f"adding it ({_values(finding)}) changes the test RMSE from "
-        f"{finding.rmse_test_before:.2f} to {finding.rmse_test_after:.2f} °C"
-    )
+    removed = 1.0 - (finding.rmse_train_after / finding.rmse_train_before) ** 2
+    correction = finding.detail.get("correction", "")
     if finding.accepted:
         return (
-            f"The model left out {what}: {pattern}; {evidence}{facts}. Adding it "
-            f"({_values(finding)}) cuts the test RMSE from {finding.rmse_test_before:.2f} to "
+            f"The model left out {what}. Where and when: {pattern}; {correction}{facts}. "
+            f"Adding it ({_values(finding)}) removes {max(removed, 0.0):.0%} of the training "
+            f"error and cuts the test RMSE from {finding.rmse_test_before:.2f} to "
             f"{finding.rmse_test_after:.2f} °C."
         )
-    return f"Not confirmed — {what}: {evidence}{facts}; {change} ({finding.reason})."
+    return (
+        f"Not confirmed — {what}{facts}: adding it ({_values(finding)}) changes the test RMSE "
+        f"from {finding.rmse_test_before:.2f} to {finding.rmse_test_after:.2f} °C "
+        f"({finding.reason})."
+    )
 
 
 def _facts(finding: Finding) -> str:
     d = finding.detail
     if "orientations" in d:
-        faces = ", ".join(f"{v['facade']} {v['area_m2']:g} m²" for v in d["orientations"].values())
-        peak = d.get("peak_irradiance_W_m2")
-        extra = f", up to {peak:.0f} W/m² on the glazing" if peak else ""
-        return f" ({faces}{extra})"
+        peaks = d.get("peak_input", {})
+        faces = ", ".join(
+            f"{v['facade']} {v['area_m2']:g} m²"
+            + (
+                f" receiving up to {peaks[s] / v['area_m2']:.0f} W/m²"
+                if (s := _signal_of(finding, k)) in peaks
+                else ""
+            )
+            for k, v in d["orientations"].items()
+        )
+        return f" ({faces})"
     if "schedule" in d:
         return f" (schedule learnt from the residuals: {d['schedule']})"
     return ""
+
+
+def _signal_of(finding: Finding, orientation: str) -> str:
+    kind = "window" if finding.effect == "window_solar_gains" else "opaque"
+    return f"solar_{kind}_{orientation}"
 
 
 @dataclass
