@@ -1,10 +1,13 @@
 """Speed of one calibration: `basic` on 7 days at 15 min with the thesis's GA + GPS settings.
 
-Baseline, timed in the same run: the obvious hand-written alternative — every candidate simulated
-with scipy.integrate.solve_ivp (LSODA, inputs held over each step) inside the same GA + GPS. It is
-run until a budget of simulations and its per-simulation cost extrapolated to the engine's count.
-Also reports throughput of the batched simulator alone (week-long simulations per second, one
-core). Prints a JSON line last.
+Data: the committed EnergyPlus office (data/energyplus/office/heating.csv, building.json), the
+week from Monday 2017-01-09. Baseline, timed in the same run: the obvious hand-written
+alternative — every candidate simulated with scipy.integrate.solve_ivp (LSODA, inputs held over
+each step) inside the same GA + GPS. It is run for a budget of simulations only and its
+per-simulation cost extrapolated to the engine's count (the output says so). Also reports the
+throughput of the batched simulator alone, CPU time next to wall time (other jobs may share the
+cores: the load average is printed with the timings), and whether the least-squares polish beats
+GPS on the same week for `basic` and `sun`. Prints a JSON line last.
 
     python benchmarks/estimate_speed.py [--data CSV --building JSON --start ISO]
 """
@@ -23,15 +26,15 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the target says
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
-from rcengine.io.timeseries import read_timeseries
 from scipy.integrate import solve_ivp
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
 from rcengine.estimate import Estimator, search, settings_for
 from rcengine.exceptions import ConvergenceWarning
+from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
-from rcengine.network import CompiledNetwork
+from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.search_space import SearchSpace
 from rcengine.signals import prepare
 from rcengine.simulate import modal_system, simulate_modal
@@ -84,14 +87,33 @@ class SolveIvpObjective:
         return costs
 
 
-def load(args: argparse.Namespace) -> tuple[Building, Dataset]:
+def load(args: argparse.Namespace, model: str) -> tuple[RCNetwork, Dataset]:
+    """The model for the building and the 7 days from ``args.start``, its signals derived."""
     building = Building.from_json(args.building)
     frame = read_timeseries(args.data)
-    net = get_model("basic", building, frame.columns).compile()
-    data = prepare(frame, building, net.input_names)
+    net = get_model(model, building, frame.columns)
+    data = prepare(frame, building, net.compile().input_names)
     start = data.times[0] if args.start is None else args.start
     end = (data.between(start).times[0]) + np.timedelta64(7, "D")
-    return building, data.between(start, end)
+    return net, data.between(start, end)
+
+
+def load_average() -> str:
+    """The 1, 5 and 15 min load averages (as `uptime` prints them), for the record."""
+    return ", ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def polish_report(net: RCNetwork, week: Dataset) -> dict:
+    """Thesis GA + GPS, then the least-squares polish: does it lower the cost?"""
+    est = Estimator(net, preset="thesis", polish=True, random_state=0).fit(week)
+    gps, polished = est.polish_["cost_gps"], est.polish_["cost_polished"]
+    return {
+        "rmse_gps_K": round(float(np.sqrt(gps)), 6),
+        "rmse_polished_K": round(float(np.sqrt(polished)), 6),
+        "cost_reduction_pct": round(100.0 * (1.0 - polished / gps), 4),
+        "improved": est.polish_["improved"],
+        "wall_s": round(est.wall_time_s_, 3),
+    }
 
 
 def simulator_throughput(net: CompiledNetwork, data: Dataset, population: int = 1000) -> float:
@@ -116,14 +138,15 @@ def main() -> None:
     parser.add_argument("--building", default=str(OFFICE / "building.json"))
     parser.add_argument("--start", default="2017-01-09T00:00:00+01:00")
     args = parser.parse_args()
-    building, week = load(args)
-    net = get_model("basic", building, week.frame.columns)
+    net, week = load(args, "basic")
     compiled = net.compile()
     warnings.simplefilter("ignore", ConvergenceWarning)
 
-    started = time.perf_counter()
+    load_before = load_average()
+    started, cpu_started = time.perf_counter(), time.process_time()
     est = Estimator(net, preset="thesis", random_state=0).fit(week)
-    wall = time.perf_counter() - started
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
+    load_engine = load_average()
 
     baseline = SolveIvpObjective(compiled, week, BASELINE_BUDGET)
     space = SearchSpace(compiled)
@@ -138,18 +161,29 @@ def main() -> None:
     per_sim = (time.perf_counter() - t0) / max(1, baseline.count)
     baseline_wall = per_sim * est.n_simulations_
     throughput = simulator_throughput(compiled, week)
+    polish = {"basic": polish_report(net, week), "sun": polish_report(*load(args, "sun"))}
 
-    print("basic, 7 days × 96 steps, thesis GA (15 × 20) + GPS (≤ 500 it.)")
+    print(f"basic, 7 days × 96 steps from {week.times[0]}, thesis GA (15 × 20) + GPS (≤ 500 it.)")
+    print(f"  load average before / after the engine's fit: {load_before} / {load_engine}")
     print(
-        f"  engine:   {wall:.3f} s, {est.n_simulations_} simulations "
-        f"({est.n_simulations_ / wall:,.0f}/s inside the estimator), RMSE {est.rmse_:.3f} K"
+        f"  engine:   {wall:.3f} s wall, {cpu:.3f} s CPU, {est.n_simulations_} simulations "
+        f"({est.n_simulations_ / wall:,.0f}/s wall, {est.n_simulations_ / cpu:,.0f}/s per CPU "
+        f"second), RMSE {est.rmse_:.3f} K"
     )
     print(
-        f"  solve_ivp baseline: {per_sim * 1e3:.1f} ms per simulation (measured on "
-        f"{baseline.count}), so {baseline_wall:,.0f} s for the same search "
-        f"({baseline_wall / wall:,.0f}× slower)"
+        f"  solve_ivp baseline: {per_sim * 1e3:.1f} ms per simulation, measured on the first "
+        f"{baseline.count} candidates of its search and extrapolated to {est.n_simulations_}: "
+        f"{baseline_wall:,.0f} s ({baseline_wall / wall:,.0f}× slower)"
     )
     print(f"  batched simulator alone: {throughput:,.0f} week-long simulations/s on one core")
+    for model, p in polish.items():
+        verdict = "beats" if p["improved"] else "does not beat"
+        print(
+            f"  polish ({model}, thesis GA + GPS then least squares): training RMSE "
+            f"{p['rmse_gps_K']:.6f} K after GPS, {p['rmse_polished_K']:.6f} K polished — "
+            f"{verdict} GPS, cost {p['cost_reduction_pct']:.4f} % lower ({p['wall_s']:.2f} s)"
+        )
+    print(f"  load average at the end: {load_average()}")
     print(
         json.dumps(
             {
@@ -159,10 +193,15 @@ def main() -> None:
                 "simulations": est.n_simulations_,
                 "sims_per_s": round(est.n_simulations_ / wall),
                 "baseline_wall_s": round(baseline_wall, 1),
+                "baseline_extrapolated_from": baseline.count,
                 "baseline_s_per_sim": round(per_sim, 4),
                 "speedup": round(baseline_wall / wall),
+                "cpu_s": round(cpu, 3),
+                "sims_per_cpu_s": round(est.n_simulations_ / cpu),
                 "simulator_sims_per_s": round(throughput),
                 "rmse_K": round(est.rmse_, 4),
+                "polish": polish,
+                "load_avg": load_engine,
             }
         )
     )

@@ -43,6 +43,13 @@ class Segment:
     def mask(self) -> np.ndarray:
         return np.isfinite(self.y)
 
+    @property
+    def observed(self) -> np.ndarray | slice:
+        """Index of the measured rows; a plain slice when every row is (indexing then copies
+        nothing)."""
+        mask = self.mask
+        return slice(None) if mask.all() else mask
+
 
 @dataclass(frozen=True)
 class Trajectory:
@@ -101,7 +108,7 @@ class Objective:
         parts = []
         for seg in self.segments:
             y_fit, _ = self._fit_segment(system, seg)
-            parts.append((seg.y - y_fit)[:, seg.mask])
+            parts.append((seg.y - y_fit)[:, seg.observed])
         resid = np.concatenate(parts, axis=1)
         resid[~system.valid] = np.nan
         return resid
@@ -116,8 +123,8 @@ class Objective:
         if not profiled or not seg.mask.any():
             return y_forced, prior
         sensitivity = free_response(system, seg.u.shape[0], profiled)
-        seen = sensitivity[:, seg.mask, :]
-        r = (seg.y - y_forced)[:, seg.mask]
+        seen = sensitivity[:, seg.observed, :]
+        r = (seg.y - y_forced)[:, seg.observed]
         seen_t = np.swapaxes(seen, 1, 2)
         gram = seen_t @ seen
         gram += _RIDGE_PER_STEP * seg.u.shape[0] * np.eye(len(profiled))

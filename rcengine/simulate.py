@@ -28,11 +28,8 @@ _BLOCK_ELEMENTS = 100_000
 # Populations with at least this many modes in total are scanned step by step (the per-step
 # Python overhead is amortised); narrower ones in blocks of _SCAN_BLOCK steps.
 _WIDE_POPULATION = 300
-
-
-def _scan_block(width: int) -> int:
-    """Steps per block: long blocks for a single candidate (fewer carries), short otherwise."""
-    return 32 if width <= 9 else 8
+# Steps per block of the two-level scan; 8 is fastest from 1 to ~100 candidates of 3 modes.
+_SCAN_BLOCK = 8
 
 
 @dataclass(frozen=True)
@@ -123,32 +120,43 @@ def _scan_loop(decay: np.ndarray, forcing: np.ndarray, z: np.ndarray) -> tuple:
 
 
 def _scan_blocked(decay: np.ndarray, forcing: np.ndarray, z: np.ndarray) -> tuple:
-    """The same recursion, L steps at a time for narrow populations.
+    """The same recursion in two levels for narrow populations, every loop over a short axis.
 
-    Within a block starting from z_b:  z[b+j] = a^j z_b + Σ_{i<j} a^{j−1−i} f[b+i],  a lower-
-    triangular Toeplitz product; only the block-to-block carry is a Python loop. Every power of
-    a is ≤ 1, so this is as well conditioned as the step-by-step loop.
+    Cut the steps into blocks of L. Within every block at once, from a zero start:
+    w[b, j+1] = a·w[b, j] + f[bL+j] (L steps, vectorised over blocks). The block-start states
+    then obey c[b+1] = a^L c[b] + e[b], e[b] = a·w[b, L−1] + f[bL+L−1], c[0] = z, a first-order
+    recursion solved by a log-depth prefix scan (c[b] += a^{Ld} c[b−d] for d = 1, 2, 4 …;
+    Hillis & Steele 1986). Finally z[bL+j] = a^j c[b] + w[b, j]. Every power of a is ≤ 1, so
+    this is as well conditioned as the step-by-step loop.
     """
     steps, S, n = forcing.shape
-    L = _scan_block(S * n)
+    L = _SCAN_BLOCK
     n_blocks = -(-steps // L)
-    padded = np.zeros((n_blocks * L, S, n))
-    padded[:steps] = forcing
-    f = padded.reshape(n_blocks, L, S, n).transpose(2, 3, 1, 0)  # (S, n, L, blocks)
-    lag = np.arange(L + 1)[:, None] - 1 - np.arange(L)[None, :]
-    toeplitz = np.where(lag >= 0, decay[:, :, None, None] ** np.maximum(lag, 0), 0.0)
-    within = toeplitz @ f  # (S, n, L+1, blocks): zero-start response, row L = block end
-    decay_block = decay**L
-    carry = np.empty((S, n, n_blocks))
-    for b in range(n_blocks):
-        carry[:, :, b] = z
-        z = decay_block * z + within[:, :, L, b]
-
-    powers = decay[:, :, None] ** np.arange(L)
-    states = powers[:, :, :, None] * carry[:, :, None, :] + within[:, :, :L, :]
-    states = states.transpose(3, 2, 0, 1).reshape(n_blocks * L, S, n)[:steps]
-    # The carry ran on to the padded end; step once from the last real state instead.
-    return states, decay * states[-1] + forcing[-1]
+    if steps % L:
+        padded = np.zeros((n_blocks * L, S, n))
+        padded[:steps] = forcing
+        forcing = padded
+    f = forcing.reshape(n_blocks, L, S, n)
+    states = np.empty((n_blocks, L, S, n))
+    states[:, 0] = 0.0
+    for j in range(L - 1):
+        np.multiply(states[:, j], decay, out=states[:, j + 1])
+        states[:, j + 1] += f[:, j]
+    carry = np.empty((n_blocks, S, n))
+    carry[0] = z
+    np.multiply(states[:-1, L - 1], decay, out=carry[1:])
+    carry[1:] += f[:-1, L - 1]
+    factor = decay**L
+    shift = 1
+    while shift < n_blocks:
+        # The right-hand side is evaluated before the in-place add: every update of a level
+        # reads the previous level, as the prefix scan requires.
+        carry[shift:] += factor * carry[:-shift]
+        factor = factor * factor
+        shift *= 2
+    states += decay ** np.arange(L)[:, None, None] * carry[:, None]
+    states = states.reshape(n_blocks * L, S, n)[:steps]
+    return states, decay * states[-1] + forcing[steps - 1]
 
 
 def free_response(system: ModalSystem, steps: int, nodes: list[int]) -> np.ndarray:
@@ -157,15 +165,16 @@ def free_response(system: ModalSystem, steps: int, nodes: list[int]) -> np.ndarr
     Returns O (S, steps, len(nodes)) with O[:, k, j] = y[k] for T[0] = e_{nodes[j]}.
     """
     S = system.size
-    gains = system.output[:, :, None] * system.to_modal[:, :, nodes]  # (S, n, j)
+    gains = system.output[:, None, :] * np.swapaxes(system.to_modal[:, :, nodes], 1, 2)  # (S,j,n)
     log_decay = np.log(np.maximum(system.decay, 1e-300))
-    out = np.empty((S, steps, len(nodes)))
+    # Filled as (S, j, steps), so each product is contiguous; returned as a (S, steps, j) view.
+    out = np.empty((S, len(nodes), steps))
     block = max(1, _BLOCK_ELEMENTS // max(1, S * system.decay.shape[1]))
     for start in range(0, steps, block):
         k = np.arange(start, min(steps, start + block))
         powers = np.exp(log_decay[:, :, None] * k[None, None, :])  # (S, n, t)
-        out[:, start : start + k.size, :] = np.swapaxes(powers, 1, 2) @ gains
-    return out
+        out[:, :, start : start + k.size] = gains @ powers
+    return np.swapaxes(out, 1, 2)
 
 
 def simulate(rc: RCMatrices, u: np.ndarray, x0: np.ndarray, dt: float) -> np.ndarray:

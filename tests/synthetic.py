@@ -3,6 +3,8 @@ out by hand and integrated with scipy's solve_ivp (not the engine's network or d
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
@@ -93,3 +95,22 @@ def basic_reference(
         sol = solve_ivp(rhs, (0.0, STEP_S), x, args=(row,), rtol=1e-10, atol=1e-10)
         x = sol.y[:, -1]
     return out
+
+
+# --- Sun model: real weather, geometric solar inputs ---------------------------------------------
+
+TRUTH_SUN = {**TRUTH_BASIC, "alpha_wall": 0.12, "alpha_int": 0.55}
+WEATHER_COLUMNS = ("t_out", "ghi", "dni", "dhi")
+
+
+def with_recorded_weather(frame: pd.DataFrame, csv_path: str | Path) -> pd.DataFrame:
+    """``frame`` with t_out, ghi, dni, dhi taken from a contract CSV at the same UTC times.
+
+    Read with pandas, not the engine's reader, so the reference stays independent of it.
+    """
+    recorded = pd.read_csv(csv_path, usecols=["time", *WEATHER_COLUMNS])
+    recorded.index = pd.to_datetime(recorded.pop("time"), utc=True)
+    weather = recorded.reindex(frame.index)
+    if weather.isna().any().any():
+        raise ValueError(f"{csv_path} does not cover {frame.index[0]} … {frame.index[-1]}")
+    return frame.assign(**{c: weather[c].to_numpy() for c in WEATHER_COLUMNS})
