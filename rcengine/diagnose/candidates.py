@@ -250,9 +250,8 @@ def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> np.ndarra
     Sunday) is the value that, passed through the fitted model's dynamics, best explains the
     training residual (a deconvolution: the raw residual is the missing heat smeared and delayed
     by the building's inertia), while the model's own parameters may move to undo what they had
-    absorbed; pooling the five weekdays damps least squares' spiky solutions. The schedule is on
-    where θ exceeds a share of its peak, the share (0.2–0.8) whose on/off schedule explains the
-    residual best.
+    absorbed. The schedule is on where the smoothed θ exceeds a share of its peak, the share
+    (0.2–0.8) whose on/off schedule explains the residual best.
     """
     data = ctx.data
     tz = ctx.building.location.timezone
@@ -261,7 +260,12 @@ def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> np.ndarra
     heat[np.arange(len(data)), hour] = per_unit
     responses = node_responses(ctx.network, ctx.params, data, node, heat)
     theta, _ = explain_residual(ctx.residual, responses, ctx.sensitivities)
-    profile = weekly_from_day_types(theta)
+    # Neighbouring hours share a schedule; the mean over three damps least squares' spiky
+    # solutions, which would otherwise set the peak (each day type wraps around midnight).
+    days = theta.reshape(N_DAY_TYPES, 24)
+    profile = weekly_from_day_types(
+        (np.roll(days, 1, axis=1) + days + np.roll(days, -1, axis=1)) / 3.0
+    )
     options = [on_hours(profile, share) for share in ON_SHARES]
     signals = np.column_stack([schedule_signal(o, data.times, tz) * per_unit for o in options])
     on_off = node_responses(ctx.network, ctx.params, data, node, signals)
