@@ -190,17 +190,21 @@ def study(
     start: Annotated[str | None, typer.Option(help="first predicted day (YYYY-MM-DD)")] = None,
     end: Annotated[str | None, typer.Option(help="last predicted day, exclusive")] = None,
     workers: Annotated[int, typer.Option(help="processes (0: every core)")] = 0,
-    preset: Annotated[str, typer.Option(help="estimator preset")] = "default",
+    preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "study",
+    seed: Annotated[int, typer.Option(help="random seed")] = 0,
 ) -> None:
     """The thesis's rolling learn/predict study: tables, summary.json and figures."""
     import os
+    import time
 
-    from tqdm import tqdm
-
-    from .study import StudySettings, run_study
+    from .study import StudySettings, progress_bar, run_study
     from .study_report import write_study
 
+    if preset not in PRESETS:
+        fail(f"invalid preset {preset!r}; choose from {sorted(PRESETS)}")
+
     def run() -> None:
+        started = time.perf_counter()
         b = Building.from_json(building)
         frame = read_timeseries(data)
         settings = StudySettings(
@@ -209,16 +213,16 @@ def study(
             start=start,
             end=end,
             workers=workers or os.cpu_count() or 1,
+            random_state=seed,
         )
-        with tqdm(total=0, unit="day", desc="learn/predict") as bar:
-
-            def progress(done: int, total: int) -> None:
-                bar.total = total
-                bar.update(done - bar.n)
-
+        with progress_bar() as progress:
             results = run_study(frame, b, settings, progress)
+        typer.echo("writing tables, figures and the free-floating validation …")
         free = read_timeseries(freefloat) if freefloat else None
         written = write_study(results, settings, frame, b, free, output)
-        typer.echo(f"{len(results)} trainings; wrote {len(written)} files to {output}")
+        typer.echo(
+            f"{len(results)} trainings in {time.perf_counter() - started:.0f} s; "
+            f"wrote {len(written)} files to {output}"
+        )
 
     _run(run)

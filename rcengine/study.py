@@ -5,7 +5,8 @@ ahead, for each model, on the "Complete period" (all days) and the "Selected per
 only). In the Selected period the weekends are gaps: training simulates each weekday run from its
 own initial state, and a forecast that spans a weekend restarts on Monday from the state the
 Kalman filter estimates over the (measured) weekend, so Friday never flows into Monday.
-Predictions start from the state filtered over the 48 h of measurements before them.
+Predictions start from the state filtered over the 48 h of measurements before them. Beside
+every forecast the naive one, "tomorrow = today" (persistence), is scored on the same days.
 """
 
 from __future__ import annotations
@@ -13,20 +14,23 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from .building import Building
+from .columns import GHI, Q_HVAC, T_IN
 from .dataset import Dataset
-from .estimate import Estimator
+from .estimate import Estimator, EstimatorSettings
 from .exceptions import ConvergenceWarning
 from .forecast import forecast
 from .metrics import evaluate, rmse
 from .models import get_model
+from .models.thesis import SOLAR_OPAQUE, SOLAR_WINDOW
 from .signals import SignalOptions, prepare
 
 PERIODS = ("complete", "selected")
@@ -41,7 +45,7 @@ class StudySettings:
     periods: tuple[str, ...] = PERIODS
     learn_days: tuple[int, ...] = (1, 3, 5, 7)
     horizons: tuple[int, ...] = (1, 3, 7)
-    preset: str = "default"
+    preset: str | EstimatorSettings = "study"
     start: str | None = None
     end: str | None = None
     workers: int = field(default_factory=lambda: os.cpu_count() or 1)
@@ -106,14 +110,17 @@ def _forecast_days(
         fc = forecast(compiled, params, data, run[0], hours=24 * len(run))
         times.append(fc.times)
         predicted.append(fc.t_in_pred)
-        measured.append(data.frame["t_in"].reindex(fc.times).to_numpy(dtype=float))
+        measured.append(data.frame[T_IN].reindex(fc.times).to_numpy(dtype=float))
     return times[0].append(times[1:]), np.concatenate(predicted), np.concatenate(measured)
 
 
 @dataclass(frozen=True)
 class Prediction:
+    """The fitted estimator, its wall and CPU time [s], and the forecast against the record."""
+
     estimator: Estimator
     wall_s: float
+    cpu_s: float
     times: pd.DatetimeIndex
     predicted: np.ndarray
     measured: np.ndarray
@@ -124,17 +131,31 @@ def learn_and_predict(
     network,
     past: list[pd.Timestamp],
     ahead: list[pd.Timestamp],
-    preset: str,
+    preset: str | EstimatorSettings,
     random_state: int,
 ) -> Prediction:
     """Fit on the ``past`` days, forecast the ``ahead`` days."""
-    started = time.perf_counter()
+    # CPU time beside wall time: other processes sharing the cores inflate only the latter.
+    started, started_cpu = time.perf_counter(), time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         est = Estimator(network, preset=preset, random_state=random_state).fit(data.on_days(past))
-    wall = time.perf_counter() - started
+    wall, cpu = time.perf_counter() - started, time.process_time() - started_cpu
     times, predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead)
-    return Prediction(est, wall, times, predicted, measured)
+    return Prediction(est, wall, cpu, times, predicted, measured)
+
+
+def persistence(
+    data: Dataset, yesterday: pd.Timestamp, times: pd.DatetimeIndex, timezone: str
+) -> np.ndarray:
+    """The naive forecast "tomorrow = today": every predicted step takes the t_in measured at the
+    same local time of ``yesterday`` (the last day before the forecast in the period's calendar,
+    a local midnight). [°C]"""
+    wall_clock = times.tz_convert(timezone).tz_localize(None)
+    source = yesterday.tz_localize(None) + (wall_clock - wall_clock.normalize())
+    # The hour repeated or skipped by a daylight-saving change has no single match: left out.
+    source = source.tz_localize(timezone, ambiguous="NaT", nonexistent="NaT").tz_convert("UTC")
+    return data.frame[T_IN].reindex(source).to_numpy(dtype=float)
 
 
 def run_task(task: Task) -> list[dict]:
@@ -145,13 +166,15 @@ def run_task(task: Task) -> list[dict]:
     days = local_days(data, building.location.timezone)
     net = get_model(task.model, building, data.frame.columns)
     ahead = _window(days, task.day, max(settings.horizons), task.period, before=False)
+    yesterday = _window(days, task.day, 1, task.period, before=True)
     steps_per_day = round(86400 / data.step_s)
     out = []
     for learn in settings.learn_days:
         past = _window(days, task.day, learn, task.period, before=True)
-        if past is None or ahead is None:
+        if past is None or ahead is None or yesterday is None:
             continue
         p = learn_and_predict(data, net, past, ahead, settings.preset, settings.random_state)
+        naive = persistence(data, yesterday[0], p.times, building.location.timezone)
         row = {
             "model": task.model,
             "period": task.period,
@@ -160,14 +183,31 @@ def run_task(task: Task) -> list[dict]:
             "learn_days": learn,
             "rmse_train": p.estimator.rmse_,
             "wall_s": p.wall_s,
+            "cpu_s": p.cpu_s,
             "n_simulations": p.estimator.n_simulations_,
             **p.estimator.params_,
         }
         for h in settings.horizons:
             n = h * steps_per_day
             row[f"rmse_h{h}"] = rmse(p.measured[:n], p.predicted[:n])
+        for h in settings.horizons:
+            n = h * steps_per_day
+            row[f"rmse_persistence_h{h}"] = rmse(p.measured[:n], naive[:n])
+        # Where the first day's error lies: while the heating runs (setpoint held, morning
+        # recovery) or while the building floats (nights, weekends).
+        first = slice(0, steps_per_day)
+        heating = data.frame[Q_HVAC].reindex(p.times[first]).to_numpy(dtype=float) > 0
+        for label, mask in (("on", heating), ("off", ~heating)):
+            row[f"rmse_day1_heating_{label}"] = _rmse_where(
+                p.measured[first], p.predicted[first], mask
+            )
         out.append(row)
     return out
+
+
+def _rmse_where(measured: np.ndarray, predicted: np.ndarray, mask: np.ndarray) -> float:
+    """RMSE over the steps in ``mask``; NaN when there are none. [K]"""
+    return rmse(measured[mask], predicted[mask]) if mask.any() else float("nan")
 
 
 def example(
@@ -178,7 +218,7 @@ def example(
     learn_days: int,
     horizon_days: int,
     period: str = "complete",
-    preset: str = "default",
+    preset: str | EstimatorSettings = "study",
 ) -> Prediction:
     """One learn/predict pair for the example figures (thesis Fig. 3.1–3.3)."""
     data = _prepared(frame, building, model)
@@ -192,6 +232,20 @@ def example(
     return learn_and_predict(data, net, past, ahead, preset, 0)
 
 
+@contextmanager
+def progress_bar() -> Iterator[Callable[[int, int], None]]:
+    """A tqdm bar over the study's (model, period, day) tasks, as ``run_study``'s progress."""
+    from tqdm import tqdm
+
+    with tqdm(total=0, unit="day", desc="learn/predict") as bar:
+
+        def progress(done: int, total: int) -> None:
+            bar.total = total
+            bar.update(done - bar.n)
+
+        yield progress
+
+
 def tasks_for(data: Dataset, building: Building, settings: StudySettings) -> list[Task]:
     days = local_days(data, building.location.timezone)
     first_possible = (
@@ -202,13 +256,16 @@ def tasks_for(data: Dataset, building: Building, settings: StudySettings) -> lis
         chosen = chosen[chosen >= pd.Timestamp(settings.start).tz_localize(days.tz)]
     if settings.end:
         chosen = chosen[chosen < pd.Timestamp(settings.end).tz_localize(days.tz)]
-    # Every horizon needs its days inside the record.
+    # Every learning length and horizon needs its days inside the record, so that each average
+    # over days is over the same days.
     tasks = []
     for period in settings.periods:
         for day in chosen:
             if period == "selected" and day.day_of_week >= 5:
                 continue
             if _window(days, day, max(settings.horizons), period, before=False) is None:
+                continue
+            if _window(days, day, max(settings.learn_days), period, before=True) is None:
                 continue
             tasks.extend(Task(m, period, day) for m in settings.models)
     return tasks
@@ -262,7 +319,8 @@ def tables(results: pd.DataFrame, settings: StudySettings) -> dict[str, pd.DataF
 
 
 def summary(results: pd.DataFrame, settings: StudySettings) -> dict:
-    """Average RMSE per model, period, learning length and horizon; estimation wall times."""
+    """Average RMSE per model, period, learning length and horizon, the persistence forecast's on
+    the same days, and the estimation times (wall and CPU) per model and learning length."""
     avg: dict = {}
     for (model, period, learn), group in results.groupby(["model", "period", "learn_days"]):
         entry = avg.setdefault(model, {}).setdefault(period, {})
@@ -270,25 +328,146 @@ def summary(results: pd.DataFrame, settings: StudySettings) -> dict:
             f"predict_{h}d": float(group[f"rmse_h{h}"].mean()) for h in settings.horizons
         }
         entry[f"learn_{learn}d"]["train"] = float(group["rmse_train"].mean())
-    wall = {
+    long = results[results.learn_days >= 3]
+    headline = {}
+    for (model, period), g in long.groupby(["model", "period"]):
+        days = g.drop_duplicates("day")
+        headline[f"{model}_{period}"] = {
+            **{f"rmse_{h}d_learn_ge_3d": float(g[f"rmse_h{h}"].mean()) for h in settings.horizons},
+            **{
+                f"persistence_{h}d": float(days[f"rmse_persistence_h{h}"].mean())
+                for h in settings.horizons
+            },
+            "rmse_1d_heating_on": float(g["rmse_day1_heating_on"].mean()),
+            "rmse_1d_heating_off": float(g["rmse_day1_heating_off"].mean()),
+            "days": len(days),
+        }
+    return {
+        "settings": {
+            "models": list(settings.models),
+            "periods": list(settings.periods),
+            "learn_days": list(settings.learn_days),
+            "horizons": list(settings.horizons),
+            "preset": settings.preset
+            if isinstance(settings.preset, str)
+            else repr(settings.preset),
+            "first_day": results["day"].min() if len(results) else None,
+            "last_day": results["day"].max() if len(results) else None,
+        },
+        "average_rmse": avg,
+        "headline": headline,
+        "estimation_wall_s": _per_learning(results, "wall_s"),
+        "estimation_cpu_s": _per_learning(results, "cpu_s"),
+        "trainings": len(results),
+    }
+
+
+def _per_learning(results: pd.DataFrame, column: str) -> dict:
+    """Mean of ``column`` per model and learning length (thesis Table 3.1)."""
+    return {
         model: {
-            f"learn_{learn}d": float(g["wall_s"].mean()) for learn, g in group.groupby("learn_days")
+            f"learn_{learn}d": float(g[column].mean()) for learn, g in group.groupby("learn_days")
         }
         for model, group in results.groupby("model")
     }
-    long = results[results.learn_days >= 3]
-    headline = {
-        f"{model}_{period}": {
-            "rmse_1d_learn_ge_3d": float(g["rmse_h1"].mean()),
-            "rmse_7d_learn_ge_3d": float(g["rmse_h7"].mean()) if "rmse_h7" in g else None,
-        }
-        for (model, period), g in long.groupby(["model", "period"])
-    }
+
+
+# Daily clearness index (Σ ghi / Σ clear-sky ghi) separating overcast, mixed and sunny days.
+SKY_CLASSES = ((0.0, 0.4, "overcast"), (0.4, 0.7, "mixed"), (0.7, np.inf, "sunny"))
+
+
+def daily_clearness(frame: pd.DataFrame, building: Building) -> pd.Series:
+    """Clearness index of each local day, Σ ghi / Σ clear-sky ghi (Ineichen–Perez), indexed by
+    ISO date. [-]"""
+    from .solar import clear_sky_ghi
+
+    local_day = frame.index.tz_convert(building.location.timezone).normalize()
+    clear = pd.Series(clear_sky_ghi(frame.index, building.location), index=frame.index)
+    index = frame[GHI].groupby(local_day).sum() / clear.groupby(local_day).sum()
+    return pd.Series(index.to_numpy(), index=index.index.strftime("%Y-%m-%d"))
+
+
+def sky_class(clearness: float) -> str:
+    return next(name for low, high, name in SKY_CLASSES if low <= clearness < high)
+
+
+def _paired(results: pd.DataFrame, horizons: tuple[int, ...]) -> pd.DataFrame:
+    """Basic and Sun RMSE side by side per (period, day, learning length); ``diff_h*`` = Basic −
+    Sun, positive where the Sun model forecast better."""
+    key = ["period", "day", "learn_days"]
+    cols = [f"rmse_h{h}" for h in horizons]
+    basic = results.loc[results.model == "basic", [*key, "weekday", *cols]]
+    sun = results.loc[results.model == "sun", [*key, *cols]]
+    both = basic.merge(sun, on=key, suffixes=("_basic", "_sun"))
+    for h in horizons:
+        both[f"diff_h{h}"] = both[f"rmse_h{h}_basic"] - both[f"rmse_h{h}_sun"]
+    return both
+
+
+def _diff_stats(group: pd.DataFrame, horizons: tuple[int, ...]) -> dict:
+    out: dict = {"pairs": len(group)}
+    for h in horizons:
+        d = group[f"diff_h{h}"]
+        out[f"basic_{h}d"] = float(group[f"rmse_h{h}_basic"].mean())
+        out[f"sun_{h}d"] = float(group[f"rmse_h{h}_sun"].mean())
+        out[f"diff_{h}d"] = float(d.mean())
+        # Neighbouring days share training data, so this standard error is a lower bound.
+        out[f"diff_{h}d_se"] = float(d.std(ddof=1) / np.sqrt(len(d))) if len(d) > 1 else None
+        out[f"sun_better_share_{h}d"] = float((d > 0).mean())
+    return out
+
+
+def sun_vs_basic(
+    results: pd.DataFrame, clearness: pd.Series, horizons: tuple[int, ...] = (1, 3, 7)
+) -> dict:
+    """Does the Sun model help? Paired Basic − Sun RMSE differences on the same days by period and
+    learning length, by the sky of the first predicted day and by weekday (≥ 3 learning days),
+    and the fitted absorption parameters of both models. Empty without both models."""
+    if not {"basic", "sun"} <= set(results.model):
+        return {}
+    pairs = _paired(results, horizons)
+    pairs["sky"] = pairs["day"].map(clearness).map(sky_class)
+    long = pairs[pairs.learn_days >= 3]
+    fitted = results[results.learn_days >= 3]
     return {
-        "average_rmse": avg,
-        "headline": headline,
-        "estimation_wall_s": wall,
-        "trainings": len(results),
+        "difference": "basic − sun [°C]; positive: the Sun model forecast better",
+        "by_learning": {
+            period: {
+                f"learn_{learn}d": _diff_stats(g, horizons) for learn, g in pg.groupby("learn_days")
+            }
+            for period, pg in pairs.groupby("period")
+        },
+        "by_sky_learn_ge_3d": {
+            period: {
+                sky: _diff_stats(pg[pg.sky == sky], horizons)
+                for _, _, sky in SKY_CLASSES
+                if (pg.sky == sky).any()
+            }
+            for period, pg in long.groupby("period")
+        },
+        "by_weekday_learn_ge_3d": {
+            period: {day: _diff_stats(g, horizons) for day, g in pg.groupby("weekday")}
+            for period, pg in long.groupby("period")
+        },
+        "absorption_quartiles_learn_ge_3d": {
+            model: {
+                name: [float(v) for v in g[name].quantile([0.25, 0.5, 0.75])]
+                for name in ("alpha_wall", "alpha_int")
+            }
+            for model, g in fitted.groupby("model")
+        },
+    }
+
+
+def solar_signal_correlation(frame: pd.DataFrame, building: Building) -> dict:
+    """Correlation of the Basic model's solar input (ghi) with the Sun model's geometric ones,
+    per timestep and per daily mean: how much the geometry can add beyond a scale factor. [-]"""
+    signals = _prepared(frame, building, "sun").frame[[GHI, SOLAR_WINDOW, SOLAR_OPAQUE]]
+    daily = signals.groupby(signals.index.tz_convert(building.location.timezone).date).mean()
+    return {
+        f"{step}_{name}": float(table[GHI].corr(table[name]))
+        for step, table in (("step", signals), ("daily", daily))
+        for name in (SOLAR_WINDOW, SOLAR_OPAQUE)
     }
 
 
@@ -299,7 +478,7 @@ def free_floating(
     learn_days: int = 12,
     predict_days: int = 12,
     start: str = "2017-02-01",
-    preset: str = "default",
+    preset: str | EstimatorSettings = "study",
 ) -> dict:
     """Thesis §3.3: learn on the ``learn_days`` before ``start`` of a free-floating record and
     predict ``predict_days``; RMSE, MBE, NMBE ("MBS"), CV(RMSE) and ASHRAE Guideline 14."""
@@ -312,7 +491,7 @@ def free_floating(
         warnings.simplefilter("ignore", ConvergenceWarning)
         est = Estimator(net, preset=preset, random_state=0).fit(train)
     fc = forecast(est.compiled, est.params_, data, day0, hours=24 * predict_days)
-    measured = data.frame["t_in"].reindex(fc.times).to_numpy(dtype=float)
+    measured = data.frame[T_IN].reindex(fc.times).to_numpy(dtype=float)
     metrics = evaluate(measured, fc.t_in_pred).to_dict()
     return {
         "model": model,

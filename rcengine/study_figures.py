@@ -21,8 +21,9 @@ def _save(fig: plt.Figure, path: Path) -> Path:
 
 
 def bars_by_learning(results: pd.DataFrame, period: str, horizon: int, path: Path) -> Path:
-    """Average RMSE of ``horizon``-day predictions per learning length, one bar per model
-    (thesis Fig. 3.4, 3.7, A.1, A.2, A.4, A.5)."""
+    """Average RMSE of ``horizon``-day predictions per learning length, one bar per model, and the
+    persistence forecast ("tomorrow = today") on the same days as a dashed line (thesis Fig. 3.4,
+    3.7, A.1, A.2, A.4, A.5)."""
     sub = results[results.period == period]
     table = sub.groupby(["learn_days", "model"])[f"rmse_h{horizon}"].mean().unstack("model")
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
@@ -32,6 +33,8 @@ def bars_by_learning(results: pd.DataFrame, period: str, horizon: int, path: Pat
         ax.bar(x + i * width, table[model], width, label=model, color=COLOURS.get(model))
         for xi, v in zip(x + i * width, table[model], strict=True):
             ax.text(xi, v, f"{v:.2f}", ha="center", va="bottom", fontsize=7)
+    naive = sub.drop_duplicates("day")[f"rmse_persistence_h{horizon}"].mean()
+    ax.axhline(naive, color="grey", linestyle="--", label=f"persistence ({naive:.2f})")
     ax.set_xticks(x + width * (len(table.columns) - 1) / 2, [f"{d} d" for d in table.index])
     ax.set_xlabel("learning length")
     ax.set_ylabel("average RMSE [°C]")
@@ -104,4 +107,35 @@ def example(
     ax.set_ylabel("indoor temperature [°C]")
     ax.legend()
     fig.autofmt_xdate()
+    return _save(fig, path)
+
+
+def sun_vs_basic(comparison: dict, path: Path) -> Path:
+    """Paired Basic − Sun RMSE difference (positive: Sun better) of 1- and 7-day predictions, per
+    learning length and per sky of the first predicted day (``study.sun_vs_basic``)."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True)
+    panels = (
+        (axes[0], comparison["by_learning"], "learning length"),
+        (
+            axes[1],
+            comparison["by_sky_learn_ge_3d"],
+            "sky of the first predicted day (≥ 3 d learning)",
+        ),
+    )
+    for ax, table, xlabel in panels:
+        bars = [(period, h) for period in table for h in (1, 7)]
+        labels = list(dict.fromkeys(k for period in table.values() for k in period))
+        width = 0.8 / len(bars)
+        x = np.arange(len(labels))
+        for i, (period, h) in enumerate(bars):
+            stats = [table[period].get(k, {}) for k in labels]
+            diffs = [st.get(f"diff_{h}d", np.nan) for st in stats]
+            errs = [st.get(f"diff_{h}d_se") or 0.0 for st in stats]
+            ax.bar(x + i * width, diffs, width, yerr=errs, capsize=2, label=f"{period}, {h}-day")
+        ax.axhline(0.0, color="black", linewidth=0.8)
+        ax.set_xticks(x + width * (len(bars) - 1) / 2, [k.replace("learn_", "") for k in labels])
+        ax.set_xlabel(xlabel)
+    axes[0].set_ylabel("RMSE Basic − RMSE Sun [°C]")
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Does the Sun model help? (> 0: Sun more accurate; bars ± 1 standard error)")
     return _save(fig, path)

@@ -9,7 +9,16 @@ import pandas as pd
 
 from . import study_figures as figs
 from .building import Building
-from .study import StudySettings, example, free_floating, summary, tables
+from .study import (
+    StudySettings,
+    daily_clearness,
+    example,
+    free_floating,
+    solar_signal_correlation,
+    summary,
+    sun_vs_basic,
+    tables,
+)
 
 # Thesis Table 3.2 and 3.3: free-floating 12-day validation of the ISO models and the thesis 3R3C.
 THESIS_FREE_FLOATING = {
@@ -17,6 +26,11 @@ THESIS_FREE_FLOATING = {
     "ISO 13790": {"rmse": 1.16, "nmbe": -4.2, "cv_rmse": 4.7},
     "ISO 52016-1": {"rmse": 0.21, "nmbe": 0.2, "cv_rmse": 0.9},
 }
+# Thesis §3.3 predicts from 1 February; the other months show how much that one date says.
+FREE_FLOATING_START = "2017-02-01"
+FREE_FLOATING_OTHER_STARTS = ("2016-11-01", "2016-12-01", "2017-01-01", "2017-03-01")
+# Thesis Fig. 3.1–3.3: (learning days, predicted days, figure name).
+EXAMPLES = ((1, 1, "fig3_1"), (3, 1, "fig3_2"), (3, 3, "fig3_3"))
 
 
 def write_study(
@@ -29,67 +43,106 @@ def write_study(
 ) -> list[Path]:
     """Tables (CSV), summary.json and figures of a finished study."""
     output.mkdir(parents=True, exist_ok=True)
-    (output / "figures").mkdir(exist_ok=True)
+    fig_dir = output / "figures"
+    fig_dir.mkdir(exist_ok=True)
     written = []
     for name, table in tables(results, settings).items():
         path = output / f"{name}.csv"
         table.to_csv(path, index=name != "parameters", float_format="%.6g")
         written.append(path)
     info = summary(results, settings)
-    fig = output / "figures"
-    tz = building.location.timezone
-    for period in settings.periods:
-        for h in settings.horizons:
-            written.append(
-                figs.bars_by_learning(results, period, h, fig / f"bars_{period}_{h}d.png")
-            )
-        for model in settings.models:
-            written.append(
-                figs.heatmap(results, model, period, fig / f"heatmap_{model}_{period}.png")
-            )
-    for weekday in ("Monday", "Tuesday", "Sunday"):
-        model = settings.models[0]
-        if (results.weekday == weekday).any():
-            written.append(
-                figs.weekday_bars(
-                    results,
-                    model,
-                    "complete",
-                    weekday,
-                    fig / f"weekday_{model}_{weekday.lower()}.png",
-                )
-            )
-    days = sorted(results.day.unique())
-    if days:
-        mid = days[len(days) // 2]
-        for learn, horizon, label in ((1, 1, "fig3_1"), (3, 1, "fig3_2"), (7, 3, "fig3_3")):
-            try:
-                p = example(
-                    frame, building, settings.models[0], mid, learn, horizon, preset=settings.preset
-                )
-            except ValueError:
-                continue
-            title = f"{settings.models[0]}: learn {learn} d, predict {horizon} d from {mid}"
-            written.append(
-                figs.example(p.times, p.measured, p.predicted, title, fig / f"{label}.png", tz)
-            )
+    comparison = sun_vs_basic(results, daily_clearness(frame, building), settings.horizons)
+    if comparison:
+        comparison["solar_signal_correlation"] = solar_signal_correlation(frame, building)
+        info["sun_vs_basic"] = comparison
+        written.append(figs.sun_vs_basic(comparison, fig_dir / "sun_vs_basic.png"))
+    written += _rmse_figures(results, settings, fig_dir)
+    written += _example_figures(results, settings, frame, building, fig_dir)
     if free is not None:
-        ff = free_floating(free, building, preset=settings.preset)
-        info["free_floating"] = {
+        info["free_floating"], paths = _free_floating(free, building, settings, fig_dir)
+        written += paths
+    path = output / "summary.json"
+    path.write_text(json.dumps(info, indent=2, default=float) + "\n")
+    written.append(path)
+    return written
+
+
+def _rmse_figures(results: pd.DataFrame, settings: StudySettings, fig_dir: Path) -> list[Path]:
+    """Bars per learning length (Fig. 3.4, 3.7, A.1–A.5), heatmaps (Fig. 3.8, A.6) and weekday
+    bars (Fig. 3.5, 3.6, A.3)."""
+    written = []
+    for period in settings.periods:
+        if not (results.period == period).any():
+            continue
+        for h in settings.horizons:
+            path = fig_dir / f"bars_{period}_{h}d.png"
+            written.append(figs.bars_by_learning(results, period, h, path))
+        for model in settings.models:
+            path = fig_dir / f"heatmap_{model}_{period}.png"
+            written.append(figs.heatmap(results, model, period, path))
+    model = settings.models[0]
+    for weekday in ("Monday", "Tuesday", "Sunday"):
+        if ((results.weekday == weekday) & (results.period == "complete")).any():
+            path = fig_dir / f"weekday_{model}_{weekday.lower()}.png"
+            written.append(figs.weekday_bars(results, model, "complete", weekday, path))
+    return written
+
+
+def _example_figures(
+    results: pd.DataFrame,
+    settings: StudySettings,
+    frame: pd.DataFrame,
+    building: Building,
+    fig_dir: Path,
+) -> list[Path]:
+    """Predictions against EnergyPlus from a mid-season Tuesday (thesis Fig. 3.1–3.3)."""
+    days = sorted(results.day.unique())
+    tuesdays = [d for d in days if pd.Timestamp(d).day_name() == "Tuesday"]
+    if not tuesdays:
+        return []
+    day, model = tuesdays[len(tuesdays) // 2], settings.models[0]
+    written = []
+    for learn, horizon, name in EXAMPLES:
+        try:
+            p = example(frame, building, model, day, learn, horizon, preset=settings.preset)
+        except ValueError:
+            continue
+        title = f"{model}: learn {learn} d, predict {horizon} d from {day}"
+        path = fig_dir / f"{name}.png"
+        tz = building.location.timezone
+        written.append(figs.example(p.times, p.measured, p.predicted, title, path, tz))
+    return written
+
+
+def _free_floating(
+    free: pd.DataFrame,
+    building: Building,
+    settings: StudySettings,
+    fig_dir: Path,
+) -> tuple[dict, list[Path]]:
+    """Thesis §3.3 for every model, from 1 February and, for robustness, from other months."""
+    out: dict = {"thesis": THESIS_FREE_FLOATING}
+    written = []
+    for model in settings.models:
+        ff = free_floating(free, building, model, start=FREE_FLOATING_START, preset=settings.preset)
+        out[model] = {
             k: ff[k] for k in ("model", "learn_days", "predict_days", "start", "metrics", "params")
         }
-        info["free_floating"]["thesis"] = THESIS_FREE_FLOATING
+        out[model]["other_starts"] = {
+            start: free_floating(free, building, model, start=start, preset=settings.preset)[
+                "metrics"
+            ]
+            for start in FREE_FLOATING_OTHER_STARTS
+        }
+        name = "fig3_9_free_floating" if model == "basic" else f"free_floating_{model}"
         written.append(
             figs.example(
                 ff["times"],
                 ff["measured"],
                 ff["predicted"],
-                "free-floating: learn 12 d, predict 12 d",
-                fig / "fig3_9_free_floating.png",
-                tz,
+                f"free-floating, {model}: learn 12 d, predict 12 d",
+                fig_dir / f"{name}.png",
+                building.location.timezone,
             )
         )
-    path = output / "summary.json"
-    path.write_text(json.dumps(info, indent=2, default=float) + "\n")
-    written.append(path)
-    return written
+    return out, written
