@@ -114,6 +114,10 @@ def test_hidden_weekly_gain_is_found_named_and_fixed(hidden_gain_record):
     assert "Mon–Fri 07:00–13:00" in accepted[0]["explanation"]
     assert d["final"]["rmse_test"] <= 0.5 * d["baseline"]["rmse_test"]
     assert d["skipped"]["wind_infiltration"] == "no wind_speed column in the data"
+    innovations = np.array(d["mismatch"]["innovations"]["train"]["hour_weekday_mean_K"], float)
+    assert innovations.shape == (7, 24)
+    # The hidden gain switches on at 07:00 on weekdays: the one-step errors are largest then.
+    assert np.nanargmax(np.nanmean(innovations[:5], axis=0)) in (7, 8)
     assert d["final"]["model"].startswith("basic+unmetered_gains")
     html = render(report)
     assert "unmetered_gains" in html and "<img" in html

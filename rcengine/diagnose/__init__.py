@@ -100,9 +100,15 @@ def diagnose(
         ),
         key=lambda f: f.sse_train,
     )
+    train_frame, test_frame = baseline.split.train.frame, baseline.split.test.frame
     locate = {
-        "train": summarize(baseline.residual_train, baseline.split.train.frame, building),
-        "test": summarize(baseline.residual_test, baseline.split.test.frame, building),
+        "train": summarize(baseline.residual_train, train_frame, building),
+        "test": summarize(baseline.residual_test, test_frame, building),
+        # One-step-ahead errors show fast, local misses the open-loop drift can hide.
+        "innovations": {
+            "train": summarize(baseline.innovations_train, train_frame, building),
+            "test": summarize(baseline.innovations_test, test_frame, building),
+        },
     }
     current, skipped = baseline, {}
     verdicts: dict[str, Finding] = {}

@@ -260,6 +260,7 @@ class Report:
                 "summary": self.locate["test"]["summary"],
                 "train": self.locate["train"],
                 "test": self.locate["test"],
+                "innovations": self.locate["innovations"],
             },
             "findings": [f.to_dict() for f in self.findings],
             "final": {
