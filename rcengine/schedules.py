@@ -2,17 +2,36 @@
 
 Office buildings repeat their week; a gain or ventilation rate missing from the data shows up in
 the residuals with that weekly rhythm, so a schedule is the natural shape for such an input.
+
+A schedule runs on one of two clocks: "local", the civil time of the building's zone with its
+daylight-saving shifts, or "standard", the zone's standard time all year round — how controllers
+that ignore daylight saving (and EnergyPlus runs without a daylight-saving period) keep time.
 """
 
 from __future__ import annotations
+
+import datetime as dt
 
 import numpy as np
 import pandas as pd
 
 HOURS_PER_WEEK = 168
+CLOCKS = ("local", "standard")
+Zone = str | dt.tzinfo
 
 
-def hour_of_week(times: pd.DatetimeIndex, timezone: str) -> np.ndarray:
+def clock_zone(timezone: str, clock: str) -> Zone:
+    """The time zone a schedule on ``clock`` ("local" or "standard") reads its hours in."""
+    if clock == "local":
+        return timezone
+    if clock != "standard":
+        raise ValueError(f"unknown schedule clock {clock!r}; choose one of {CLOCKS}")
+    # Daylight saving only ever adds to the standard offset, in either hemisphere.
+    offsets = [pd.Timestamp(f"2021-{month:02d}-15", tz=timezone).utcoffset() for month in (1, 7)]
+    return dt.timezone(min(offsets))
+
+
+def hour_of_week(times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
     """0 = Monday 00:00–01:00 local time … 167 = Sunday 23:00–24:00."""
     local = times.tz_convert(timezone)
     return np.asarray(local.day_of_week * 24 + local.hour, dtype=int)
@@ -24,7 +43,7 @@ DAY_TYPE_OF_WEEKDAY = np.array([0, 0, 0, 0, 0, 1, 2])
 N_DAY_TYPES = 3
 
 
-def day_type_hour(times: pd.DatetimeIndex, timezone: str) -> np.ndarray:
+def day_type_hour(times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
     """0–23 = weekday hours, 24–47 = Saturday, 48–71 = Sunday, in local time."""
     local = times.tz_convert(timezone)
     return np.asarray(DAY_TYPE_OF_WEEKDAY[local.day_of_week] * 24 + local.hour, dtype=int)
@@ -36,9 +55,7 @@ def weekly_from_day_types(profile: np.ndarray) -> np.ndarray:
     return profile[DAY_TYPE_OF_WEEKDAY].ravel()
 
 
-def weekly_profile(
-    values: np.ndarray, times: pd.DatetimeIndex, timezone: str
-) -> np.ndarray:
+def weekly_profile(values: np.ndarray, times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
     """Mean of ``values`` in each hour of the week (168,); hours never seen get 0."""
     how = hour_of_week(times, timezone)
     ok = np.isfinite(values)
@@ -47,9 +64,7 @@ def weekly_profile(
     return np.divide(sums, counts, out=np.zeros(HOURS_PER_WEEK), where=counts > 0)
 
 
-def schedule_signal(
-    profile: np.ndarray, times: pd.DatetimeIndex, timezone: str
-) -> np.ndarray:
+def schedule_signal(profile: np.ndarray, times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
     """The weekly profile played back at ``times``."""
     profile = np.asarray(profile, dtype=float)
     if profile.shape != (HOURS_PER_WEEK,):

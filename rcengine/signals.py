@@ -18,7 +18,7 @@ from .columns import NUMERIC_COLUMNS, T_OUT, WIND_SPEED
 from .dataset import Dataset
 from .exceptions import ModelError
 from .ground import ground_temperature
-from .schedules import schedule_signal
+from .schedules import Zone, clock_zone, schedule_signal
 
 # Indoor reference of the air-exchange loss signals: loss ∝ rate × (T_REF − t_out). [°C]
 # The true indoor temperature varies by a few kelvin around it; the fitted gain absorbs the mean.
@@ -31,7 +31,9 @@ class SignalOptions:
 
     sky_model: "isotropic" (thesis Eq. 16–17), "perez" or "haydavies"; albedo: ground reflectance
     or None to neglect reflection; iam_model: glazing incidence-angle modifier; decomposition:
-    ghi → dni/dhi model when those columns are absent.
+    ghi → dni/dhi model when those columns are absent; schedules: weekly 0/1 or level profiles
+    (168 hourly values) by name; schedule_clock: "local" (civil time, daylight saving) or
+    "standard" (standard time all year) for playing them back.
     """
 
     sky_model: str = "isotropic"
@@ -39,6 +41,10 @@ class SignalOptions:
     iam_model: str = "physical"
     decomposition: str = "erbs"
     schedules: dict[str, list[float]] = field(default_factory=dict)
+    schedule_clock: str = "local"
+
+    def schedule_zone(self, building: Building) -> Zone:
+        return clock_zone(building.location.timezone, self.schedule_clock)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -74,15 +80,15 @@ def _air_exchange(frame: pd.DataFrame, building: Building, options: SignalOption
         out["wind_loss"] = _require(frame, WIND_SPEED, "wind_loss") * (t_out - T_REF_C)
     if "vent" in options.schedules:
         schedule = schedule_signal(
-            options.schedules["vent"], frame.index, building.location.timezone
+            options.schedules["vent"], frame.index, options.schedule_zone(building)
         )
         out["vent_loss"] = schedule * (t_out - T_REF_C)
     return out
 
 
 def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """sched_<name>: a stored weekly schedule played back in local time. [-]"""
-    tz = building.location.timezone
+    """sched_<name>: a stored weekly schedule played back on its clock. [-]"""
+    tz = options.schedule_zone(building)
     return pd.DataFrame(
         {
             f"sched_{name}": schedule_signal(p, frame.index, tz)

@@ -20,16 +20,22 @@ from ..columns import Q_HVAC, T_OUT, WIND_SPEED
 from ..dataset import Dataset
 from ..network import Parameter, RCNetwork
 from ..schedules import (
+    CLOCKS,
     N_DAY_TYPES,
+    clock_zone,
     day_type_hour,
     describe,
     on_hours,
-    schedule_signal,
     weekly_from_day_types,
 )
 from ..signals import T_REF_C, SignalOptions
 from ..solar import orientation_key
-from .response import explain_residual, node_responses, parameter_sensitivities
+from .response import (
+    explain_residual,
+    node_responses,
+    on_off_explainer,
+    parameter_sensitivities,
+)
 
 AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
 # Shares of the learnt profile's peak tried as the on/off threshold of a schedule.
@@ -170,8 +176,10 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
         "window",
         mass_node(ctx.network),
         0.9,
-        lambda facade, area: f"share of the irradiance on the {facade} glazing ({area:g} m²) "
-        "that heats the zone (solar heat gain coefficient)",
+        lambda facade, area: (
+            f"share of the irradiance on the {facade} glazing ({area:g} m²) "
+            "that heats the zone (solar heat gain coefficient)"
+        ),
     )
     if T_OUT in ctx.network.neighbours(ctx.network.output):
         return ext
@@ -209,8 +217,10 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
         "opaque",
         envelope_node(ctx.network),
         0.3,
-        lambda facade, area: f"share of the irradiance on the {facade} opaque surfaces "
-        f"({area:g} m²) reaching the envelope node (absorptance × inward fraction)",
+        lambda facade, area: (
+            f"share of the irradiance on the {facade} opaque surfaces "
+            f"({area:g} m²) reaching the envelope node (absorptance × inward fraction)"
+        ),
     )
 
 
@@ -243,19 +253,47 @@ def wind_infiltration(ctx: Context) -> Extension | Skipped:
     )
 
 
-def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> np.ndarray:
-    """0/1 weekly schedule of a missing input ``θ_h · per_unit(t)`` at ``node``.
+@dataclass(frozen=True)
+class LearntSchedule:
+    """A 0/1 weekly schedule (168,), the clock it runs on and the residual share it explains."""
 
-    θ_h ≥ 0 for every hour of the three day types of building schedules (weekdays, Saturday,
-    Sunday) is the value that, passed through the fitted model's dynamics, best explains the
-    training residual (a deconvolution: the raw residual is the missing heat smeared and delayed
-    by the building's inertia), while the model's own parameters may move to undo what they had
-    absorbed. The schedule is on where the smoothed θ exceeds a share of its peak, the share
-    (0.2–0.8) whose on/off schedule explains the residual best.
+    schedule: np.ndarray
+    clock: str
+    explained: float
+
+    @property
+    def words(self) -> str:
+        clock = "" if self.clock == "local" else ", standard time all year (no daylight saving)"
+        return f"{describe(self.schedule)}{clock}"
+
+
+def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> LearntSchedule:
+    """0/1 weekly schedule of a missing input ``θ · schedule(t) · per_unit(t)`` at ``node``.
+
+    Learnt on both clocks a building may keep (civil time or standard time all year) unless the
+    model already plays a schedule on one; the clock whose schedule explains more is kept.
+    """
+    clocks = (ctx.signals.schedule_clock,) if ctx.signals.schedules else CLOCKS
+    learnt = [_schedule_on_clock(ctx, node, per_unit, clock) for clock in clocks]
+    return max(learnt, key=lambda s: s.explained)
+
+
+def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str) -> LearntSchedule:
+    """The schedule on one clock, in three steps.
+
+    1. θ_h ≥ 0 for every hour of the three day types of building schedules (weekdays, Saturday,
+       Sunday) is the value that, passed through the fitted model's dynamics, best explains the
+       training residual (a deconvolution: the raw residual is the missing heat smeared and
+       delayed by the building's inertia), while the model's own parameters may move to undo
+       what they had absorbed.
+    2. The schedule is on where the smoothed θ exceeds a share of its peak, the share (0.2–0.8)
+       whose on/off schedule explains the residual best.
+    3. Its switching hours then move one hour at a time while that explains the residual better:
+       smoothing blurs the edges, and an edge an hour off leaves a daily error twice a day.
     """
     data = ctx.data
-    tz = ctx.building.location.timezone
-    hour = day_type_hour(data.times, tz)
+    zone = clock_zone(ctx.building.location.timezone, clock)
+    hour = day_type_hour(data.times, zone)
     heat = np.zeros((len(data), N_DAY_TYPES * 24))
     heat[np.arange(len(data)), hour] = per_unit
     responses = node_responses(ctx.network, ctx.params, data, node, heat)
@@ -263,17 +301,31 @@ def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> np.ndarra
     # Neighbouring hours share a schedule; the mean over three damps least squares' spiky
     # solutions, which would otherwise set the peak (each day type wraps around midnight).
     days = theta.reshape(N_DAY_TYPES, 24)
-    profile = weekly_from_day_types(
-        (np.roll(days, 1, axis=1) + days + np.roll(days, -1, axis=1)) / 3.0
-    )
-    options = [on_hours(profile, share) for share in ON_SHARES]
-    signals = np.column_stack([schedule_signal(o, data.times, tz) * per_unit for o in options])
-    on_off = node_responses(ctx.network, ctx.params, data, node, signals)
-    explained = [
-        explain_residual(ctx.residual, on_off[:, [k]], ctx.sensitivities)[1]
-        for k in range(len(options))
-    ]
-    return options[int(np.argmax(explained))]
+    profile = ((np.roll(days, 1, axis=1) + days + np.roll(days, -1, axis=1)) / 3.0).ravel()
+    explained = on_off_explainer(ctx.residual, responses, ctx.sensitivities)
+    start = max((on_hours(profile, share) for share in ON_SHARES), key=explained)
+    best = _move_edges(start, explained)
+    return LearntSchedule(weekly_from_day_types(best), clock, explained(best))
+
+
+def _move_edges(
+    schedule: np.ndarray, explained: Callable[[np.ndarray], float], min_gain: float = 0.005
+) -> np.ndarray:
+    """Flip the switching hour (of the (72,) day-type schedule) that most raises ``explained``,
+    repeatedly, while it raises it by more than ``min_gain`` of its value."""
+    schedule, value = schedule.copy(), explained(schedule)
+    while True:
+        days = schedule.reshape(N_DAY_TYPES, 24)
+        edge = (days != np.roll(days, 1, axis=1)) | (days != np.roll(days, -1, axis=1))
+        trials = []
+        for h in np.flatnonzero(edge.ravel()):
+            flipped = schedule.copy()
+            flipped[h] = 1.0 - flipped[h]
+            trials.append((explained(flipped), h))
+        gain, h = max(trials, default=(0.0, -1))
+        if gain <= value * (1.0 + min_gain):
+            return schedule
+        schedule[h], value = 1.0 - schedule[h], gain
 
 
 def ventilation_schedule(ctx: Context) -> Extension | Skipped:
@@ -283,10 +335,14 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     if "vent_loss" in ctx.network.signals:
         return Skipped(effect, "the model already has a ventilation schedule")
     outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - T_REF_C
-    schedule = _learnt_schedule(ctx, ctx.network.output, outdoor_excess)
-    if not schedule.any():
+    learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess)
+    if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
-    signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "vent": schedule.tolist()})
+    signals = replace(
+        ctx.signals,
+        schedules={**ctx.signals.schedules, "vent": learnt.schedule.tolist()},
+        schedule_clock=learnt.clock,
+    )
     net = ctx.network.copy(_name(ctx.network, effect))
     upper = AIR_HEAT_CAPACITY_J_M3K * ctx.building.volume * 10.0 / 3600.0  # 10 air changes/h
     net.add_parameter(
@@ -299,7 +355,7 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
         )
     )
     net.add_heat_input("vent_loss", net.output, "h_vent")
-    detail = {"schedule": describe(schedule), "volume_m3": ctx.building.volume}
+    detail = {"schedule": learnt.words, "clock": learnt.clock, "volume_m3": ctx.building.volume}
     return Extension(
         effect,
         net,
@@ -317,10 +373,14 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     effect = "unmetered_gains"
     if "sched_gains" in ctx.network.signals:
         return Skipped(effect, "the model already has an unmetered-gain schedule")
-    schedule = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)))
-    if not schedule.any():
+    learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)))
+    if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of missing heat")
-    signals = replace(ctx.signals, schedules={**ctx.signals.schedules, "gains": schedule.tolist()})
+    signals = replace(
+        ctx.signals,
+        schedules={**ctx.signals.schedules, "gains": learnt.schedule.tolist()},
+        schedule_clock=learnt.clock,
+    )
     net = ctx.network.copy(_name(ctx.network, effect))
     net.add_parameter(
         Parameter(
@@ -332,7 +392,11 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
         )
     )
     net.add_heat_input("sched_gains", net.output, "q_unmetered")
-    detail = {"schedule": describe(schedule), "floor_area_m2": ctx.building.floor_area}
+    detail = {
+        "schedule": learnt.words,
+        "clock": learnt.clock,
+        "floor_area_m2": ctx.building.floor_area,
+    }
     return Extension(
         effect,
         net,

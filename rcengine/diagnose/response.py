@@ -8,6 +8,8 @@ segment of the record (nothing flows across a gap).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from scipy.optimize import lsq_linear
 from scipy.signal import fftconvolve
@@ -90,3 +92,23 @@ def explain_residual(
     sse_alone = float(alone @ alone)
     sse = float(fit.fun @ fit.fun)
     return fit.x[: X.shape[1]] / scale, 1.0 - sse / max(sse_alone, 1e-300)
+
+
+def on_off_explainer(
+    residual: np.ndarray, responses: np.ndarray, nuisance: np.ndarray
+) -> Callable[[np.ndarray], float]:
+    """For 0/1 weights s (m,), the share of the residual energy, beyond what the nuisance columns
+    remove, that θ·responses·s (θ ≥ 0) explains — ``explain_residual`` of the single column
+    responses·s, in O(m²) per call once the nuisance is projected out. [0–1]"""
+    ok = np.isfinite(residual) & np.isfinite(responses).all(1) & np.isfinite(nuisance).all(1)
+    u, sing, _ = np.linalg.svd(nuisance[ok], full_matrices=False)
+    basis = u[:, sing > sing.max(initial=0.0) * 1e-10]
+    R = responses[ok] - basis @ (basis.T @ responses[ok])
+    r = residual[ok] - basis @ (basis.T @ residual[ok])
+    along, gram, total = R.T @ r, R.T @ R, max(float(r @ r), 1e-300)
+
+    def explained(weights: np.ndarray) -> float:
+        projection, energy = float(weights @ along), float(weights @ gram @ weights)
+        return projection**2 / energy / total if projection > 0 and energy > 0 else 0.0
+
+    return explained
