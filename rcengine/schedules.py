@@ -73,10 +73,12 @@ def schedule_signal(profile: np.ndarray, times: pd.DatetimeIndex, timezone: Zone
 
 
 def on_hours(profile: np.ndarray, fraction: float = 0.5) -> np.ndarray:
-    """0/1 schedule: hours whose value exceeds ``fraction`` of the profile's peak."""
+    """0/1 schedule: hours whose value exceeds ``fraction`` of the profile's peak (all off when
+    nothing is positive); any length (a week, or the 72 hours of the day types)."""
+    profile = np.asarray(profile, dtype=float)
     peak = np.max(profile)
     if peak <= 0:
-        return np.zeros(HOURS_PER_WEEK)
+        return np.zeros_like(profile)
     return (profile > fraction * peak).astype(float)
 
 

@@ -36,11 +36,12 @@ TRUTH_BASIC = {
 }
 
 
-def weather_and_gains(days: int, seed: int = 3) -> pd.DataFrame:
-    """Winter-like inputs at 15 min: daily outdoor cycle, clear-sky-shaped irradiance with random
-    cloudiness, office gains on weekdays and a pseudo-random heating sequence (rich excitation)."""
+def weather_and_gains(days: int, seed: int = 3, start: str = "2017-01-09") -> pd.DataFrame:
+    """Winter-like inputs at 15 min from ``start`` (UTC): daily outdoor cycle, clear-sky-shaped
+    irradiance with random cloudiness, office gains on weekdays and a pseudo-random heating
+    sequence (rich excitation)."""
     rng = np.random.default_rng(seed)
-    times = pd.date_range("2017-01-09", periods=days * 96, freq="15min", tz="UTC")
+    times = pd.date_range(start, periods=days * 96, freq="15min", tz="UTC")
     hours = np.asarray(times.hour + times.minute / 60.0)
     day = np.arange(len(times)) // 96
     t_out = 4.0 + 4.0 * np.sin((hours - 9.0) / 24.0 * 2 * np.pi) + rng.normal(0, 1.5, days)[day]

@@ -5,7 +5,14 @@ import pandas as pd
 import pytest
 
 from rcengine.ground import ground_temperature
-from rcengine.schedules import describe, hour_of_week, on_hours, schedule_signal, weekly_profile
+from rcengine.schedules import (
+    clock_zone,
+    describe,
+    hour_of_week,
+    on_hours,
+    schedule_signal,
+    weekly_profile,
+)
 from rcengine.sky import cloud_cover_from_index, sky_temperature
 
 
@@ -13,6 +20,19 @@ def test_hour_of_week_is_local_time():
     # Monday 2017-01-09 07:00 UTC is 08:00 in Rome (UTC+1).
     times = pd.DatetimeIndex(["2017-01-09T07:00Z", "2017-01-15T22:30Z"])
     np.testing.assert_array_equal(hour_of_week(times, "Europe/Rome"), [8, 167])
+
+
+def test_standard_clock_ignores_daylight_saving():
+    # Monday 2017-07-10 07:00 UTC: 09:00 on Rome's summer clock, 08:00 on its standard time;
+    # Sydney keeps daylight saving in January, its standard time is UTC+10.
+    times = pd.DatetimeIndex(["2017-07-10T07:00Z"])
+    assert hour_of_week(times, clock_zone("Europe/Rome", "local"))[0] == 9
+    assert hour_of_week(times, clock_zone("Europe/Rome", "standard"))[0] == 8
+    january = pd.DatetimeIndex(["2017-01-09T00:00Z"])
+    assert hour_of_week(january, clock_zone("Australia/Sydney", "standard"))[0] == 10
+    assert hour_of_week(january, clock_zone("Australia/Sydney", "local"))[0] == 11
+    with pytest.raises(ValueError, match="unknown schedule clock 'solar'"):
+        clock_zone("Europe/Rome", "solar")
 
 
 def test_weekly_profile_round_trip_and_description():
@@ -25,6 +45,7 @@ def test_weekly_profile_round_trip_and_description():
     np.testing.assert_allclose(profile, truth + 0.01)
     np.testing.assert_array_equal(on_hours(profile), truth)
     assert describe(truth) == "Mon–Fri 08:00–18:00"
+    np.testing.assert_array_equal(on_hours(-np.ones(72)), np.zeros(72))
     with pytest.raises(ValueError, match="168"):
         schedule_signal(np.ones(24), times, "UTC")
 

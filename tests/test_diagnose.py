@@ -3,6 +3,7 @@ with a hidden weekly gain, and the concealed-effect EnergyPlus variants (the iss
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import warnings
 from pathlib import Path
@@ -13,11 +14,12 @@ import pytest
 
 from rcengine.diagnose import DiagnoseSettings, diagnose, split_time
 from rcengine.diagnose.candidates import CANDIDATES, Context, Skipped
-from rcengine.diagnose.fitting import fit_model, split_data
+from rcengine.diagnose.fitting import fit_model, residual_at, split_data
 from rcengine.diagnose.html import render
-from rcengine.diagnose.response import explain_residual, node_responses
+from rcengine.diagnose.response import explain_residual, node_responses, on_off_explainer
 from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
+from rcengine.schedules import CLOCKS, clock_zone
 from rcengine.signals import SignalOptions
 from rcengine.simulate import simulate
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
@@ -26,9 +28,23 @@ from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_
 HIDDEN_GAIN_W = 15_000.0
 
 
-def _hidden_gain(times: pd.DatetimeIndex) -> np.ndarray:
-    local = times.tz_convert(BUILDING.location.timezone)
+def _hidden_gain(times: pd.DatetimeIndex, zone: str | dt.tzinfo | None = None) -> np.ndarray:
+    local = times.tz_convert(zone or BUILDING.location.timezone)
     return HIDDEN_GAIN_W * ((local.day_of_week < 5) & (local.hour >= 7) & (local.hour < 13))
+
+
+def _learnt_gain_schedule(frame: pd.DataFrame) -> dict:
+    """The unmetered-gain candidate learnt from the residual of a baseline fit on 70 % of frame."""
+    network = get_model("basic", BUILDING, frame.columns)
+    boundary = split_time(frame, 0.7, BUILDING.location.timezone)
+    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        base = fit_model(network, SignalOptions(), split, "default", 0)
+    ctx = Context(
+        network, BUILDING, base.split.train, SignalOptions(), base.params, base.residual_train
+    )
+    return CANDIDATES["unmetered_gains"](ctx).detail
 
 
 @pytest.fixture(scope="module")
@@ -69,19 +85,43 @@ def test_explain_residual_separates_candidate_from_nuisance():
 
 
 def test_unmetered_gain_schedule_is_learnt_from_the_residual(hidden_gain_record):
-    frame = hidden_gain_record
+    # From the baseline's residual alone: the right days and onset (diagnose refines the end), on
+    # the civil clock (three weeks in January: both clocks agree, and the civil one is kept).
+    detail = _learnt_gain_schedule(hidden_gain_record)
+    assert detail["schedule"].startswith("Mon–Fri 07:00–")
+    assert detail["clock"] == "local"
+
+
+@pytest.mark.parametrize("clock", CLOCKS)
+def test_learnt_schedule_finds_the_clock_the_building_keeps(clock):
+    """Three weeks across the end of daylight saving (29 Oct 2017): a controller on civil time
+    and one on standard time all year put the same gain an hour apart in October. Seen through
+    the true model (the residual is the hidden gain's response alone), the schedule and its
+    clock come out exactly."""
+    inputs = weather_and_gains(21, start="2017-10-16")
+    zone = clock_zone(BUILDING.location.timezone, clock)
+    truth_inputs = inputs.assign(q_occ=inputs["q_occ"] + _hidden_gain(inputs.index, zone))
+    frame = inputs.assign(t_in=basic_reference(truth_inputs, TRUTH_BASIC, (15.0, 19.0, 19.0)))
     network = get_model("basic", BUILDING, frame.columns)
-    boundary = split_time(frame, 0.7, BUILDING.location.timezone)
-    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        base = fit_model(network, SignalOptions(), split, "default", 0)
-    ctx = Context(
-        network, BUILDING, base.split.train, SignalOptions(), base.params, base.residual_train
-    )
-    extension = CANDIDATES["unmetered_gains"](ctx)
-    # From the baseline's residual alone: the right days and onset (diagnose refines the end).
-    assert extension.detail["schedule"].startswith("Mon–Fri 07:00–")
+    data = split_data(frame, BUILDING, network, SignalOptions(), frame.index[-1]).train
+    residual = residual_at(network, TRUTH_BASIC, data)
+    ctx = Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, residual)
+    detail = CANDIDATES["unmetered_gains"](ctx).detail
+    assert detail["clock"] == clock
+    assert detail["schedule"].startswith("Mon–Fri 07:00–13:00")
+
+
+def test_on_off_explainer_equals_the_bounded_least_squares_it_shortcuts():
+    rng = np.random.default_rng(1)
+    responses, nuisance = rng.normal(size=(400, 6)), rng.normal(size=(400, 3))
+    weights = np.array([1.0, 0.0, 1.0, 1.0, 0.0, 0.0])
+    residual = 0.7 * responses @ weights + nuisance @ [1.0, -2.0, 0.5] + rng.normal(size=400)
+    explained = on_off_explainer(residual, responses, nuisance)
+    for trial in (weights, 1.0 - weights):
+        expected = explain_residual(residual, (responses @ trial)[:, None], nuisance)[1]
+        assert explained(trial) == pytest.approx(expected, rel=1e-9, abs=1e-12)
+    # θ ≥ 0: a column pointing against the residual explains nothing.
+    assert on_off_explainer(-residual, responses, nuisance)(weights) == 0.0
 
 
 def test_candidates_without_their_inputs_are_skipped_with_the_reason(hidden_gain_record):
