@@ -48,7 +48,7 @@ class DiagnoseSettings:
     candidate ids to consider (default: the whole vocabulary)."""
 
     train_fraction: float = 0.5
-    preset: str = "default"
+    preset: str = "study"
     confirm: int = 3
     min_improvement: float = 0.10
     min_improvement_k: float = 0.1
