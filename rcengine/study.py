@@ -15,7 +15,6 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -31,6 +30,7 @@ from .forecast import forecast
 from .metrics import evaluate, rmse
 from .models import get_model
 from .models.thesis import SOLAR_OPAQUE, SOLAR_WINDOW
+from .parallel import process_pool
 from .signals import SignalOptions, prepare
 
 PERIODS = ("complete", "selected")
@@ -290,9 +290,7 @@ def run_study(
             if progress:
                 progress(done, len(tasks))
     else:
-        with ProcessPoolExecutor(
-            settings.workers, initializer=_init_worker, initargs=(frame, building, settings)
-        ) as pool:
+        with process_pool(settings.workers, _init_worker, (frame, building, settings)) as pool:
             for result in pool.map(run_task, tasks, chunksize=2):
                 rows.extend(result)
                 done += 1

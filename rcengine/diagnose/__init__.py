@@ -25,6 +25,7 @@ import pandas as pd
 
 from ..building import Building
 from ..models import get_model
+from ..parallel import one_blas_thread
 from ..signals import SignalOptions
 from .candidates import CANDIDATES, Context, Extension, Skipped
 from .fitting import Fit, FitJob, fit_many, residual_at, split_data
@@ -79,7 +80,17 @@ def diagnose(
     progress: Callable[[str], None] | None = None,
 ) -> Report:
     """Run the whole diagnosis on a validated contract frame (UTC index)."""
-    settings = settings or DiagnoseSettings()
+    with one_blas_thread():
+        return _diagnose(frame, building, model, settings or DiagnoseSettings(), progress)
+
+
+def _diagnose(
+    frame: pd.DataFrame,
+    building: Building,
+    model: str,
+    settings: DiagnoseSettings,
+    progress: Callable[[str], None] | None,
+) -> Report:
     say = progress or (lambda message: None)
     started = time.perf_counter()
     boundary = split_time(frame, settings.train_fraction, building.location.timezone)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import warnings
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +16,7 @@ from ..kalman import kalman_filter
 from ..metrics import rmse
 from ..network import CompiledNetwork, RCNetwork
 from ..objective import Objective
+from ..parallel import process_pool
 from ..signals import SignalOptions, prepare
 
 
@@ -161,5 +161,5 @@ def fit_many(jobs: list[FitJob], workers: int) -> list[Fit]:
     """Run independent fits, on up to ``workers`` processes (1: in this process)."""
     if workers <= 1 or len(jobs) <= 1:
         return [job.run() for job in jobs]
-    with ProcessPoolExecutor(min(workers, len(jobs))) as pool:
+    with process_pool(min(workers, len(jobs))) as pool:
         return list(pool.map(FitJob.run, jobs))

@@ -1,0 +1,36 @@
+"""Worker processes for independent calibrations, one BLAS thread each.
+
+Each worker runs small dense linear algebra (the least-squares polish factorises a tall Jacobian
+at every step). Several processes that each start a multi-threaded BLAS on the same cores
+oversubscribe them: the BLAS threads spin-wait for one another and a diagnosis on two cores runs
+2–3× slower than with one thread per process. The pool's processes are the parallelism, and the
+parent's own small factorisations run faster on one thread too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+from threadpoolctl import threadpool_limits
+
+
+def one_blas_thread() -> threadpool_limits:
+    """Limit BLAS/OpenMP to one thread (for good, or within a ``with`` block)."""
+    return threadpool_limits(limits=1)
+
+
+def _start_worker(initializer: Callable[..., None] | None, initargs: tuple[Any, ...]) -> None:
+    one_blas_thread()
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def process_pool(
+    workers: int,
+    initializer: Callable[..., None] | None = None,
+    initargs: tuple[Any, ...] = (),
+) -> ProcessPoolExecutor:
+    """``workers`` processes limited to one BLAS/OpenMP thread each, then ``initializer``."""
+    return ProcessPoolExecutor(workers, initializer=_start_worker, initargs=(initializer, initargs))
