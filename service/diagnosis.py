@@ -48,7 +48,7 @@ log = logging.getLogger(__name__)
 class DiagnosisOptions:
     """Service-wide engine settings passed to the worker (picklable)."""
 
-    preset: str = "default"
+    preset: str = DiagnoseSettings.preset
     random_state: int = 0
 
 

@@ -9,6 +9,7 @@ from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
 
+from rcengine.diagnose import DiagnoseSettings
 from rcengine.estimate import PRESETS
 from rcengine.models import MODELS
 
@@ -54,7 +55,7 @@ class Settings(BaseSettings):
         "t_in (clipped to the stored data).",
     )
     diagnosis_preset: str = Field(
-        "default", description="Estimator preset of every fit of a diagnosis."
+        DiagnoseSettings.preset, description="Estimator preset of every fit of a diagnosis."
     )
     max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="Request size limit.")
     workers: int = Field(

@@ -43,7 +43,7 @@ DIAGNOSIS_EXAMPLE = {
         "train_fraction": 0.5,
     },
     "settings": {
-        "preset": "default",
+        "preset": "study",
         "random_state": 0,
         "train_fraction": 0.5,
         "effects": ["unmetered_gains"],
