@@ -111,6 +111,23 @@ def test_learnt_schedule_finds_the_clock_the_building_keeps(clock):
     assert detail["schedule"].startswith("Mon–Fri 07:00–13:00")
 
 
+def test_a_day_seen_once_is_an_episode_not_a_schedule():
+    """Nine days from a Monday hold one Saturday: heat on that Saturday alone is an episode the
+    weekly schedule must not absorb, while the weekday gain (seen on seven dates) is learnt."""
+    inputs = weather_and_gains(9)
+    local = inputs.index.tz_convert(BUILDING.location.timezone)
+    episode = HIDDEN_GAIN_W * (local.normalize() == pd.Timestamp("2017-01-14", tz=local.tz))
+    truth_inputs = inputs.assign(q_occ=inputs["q_occ"] + _hidden_gain(inputs.index) + episode)
+    frame = inputs.assign(t_in=basic_reference(truth_inputs, TRUTH_BASIC, (15.0, 19.0, 19.0)))
+    network = get_model("basic", BUILDING, frame.columns)
+    data = split_data(frame, BUILDING, network, SignalOptions(), frame.index[-1]).train
+    residual = residual_at(network, TRUTH_BASIC, data)
+    ctx = Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, residual)
+    schedule = CANDIDATES["unmetered_gains"](ctx).detail["schedule"]
+    # (Friday evenings stretch to soak up some of the unexplained Saturday warmth.)
+    assert schedule.startswith("Mon–Fri 07:00–") and "Sat" not in schedule, schedule
+
+
 def test_on_off_explainer_equals_the_bounded_least_squares_it_shortcuts():
     rng = np.random.default_rng(1)
     responses, nuisance = rng.normal(size=(400, 6)), rng.normal(size=(400, 3))

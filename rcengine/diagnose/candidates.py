@@ -40,6 +40,8 @@ from .response import (
 AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
 # Shares of the learnt profile's peak tried as the on/off threshold of a schedule.
 ON_SHARES = (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8)
+# Dates of a day type the training period must hold before a schedule may switch on in it.
+MIN_REPEATS = 2
 
 
 @dataclass(frozen=True)
@@ -282,10 +284,11 @@ def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str
     """The schedule on one clock, in three steps.
 
     1. θ_h ≥ 0 for every hour of the three day types of building schedules (weekdays, Saturday,
-       Sunday) is the value that, passed through the fitted model's dynamics, best explains the
-       training residual (a deconvolution: the raw residual is the missing heat smeared and
-       delayed by the building's inertia), while the model's own parameters may move to undo
-       what they had absorbed.
+       Sunday; a day type seen on fewer than two dates stays off) is the value that, passed
+       through the fitted model's dynamics, best explains the training residual (a
+       deconvolution: the raw residual is the missing heat smeared and delayed by the
+       building's inertia), while the model's own parameters may move to undo what they had
+       absorbed.
     2. The schedule is on where the smoothed θ exceeds a share of its peak, the share (0.2–0.8)
        whose on/off schedule explains the residual best.
     3. Its switching hours then move one hour at a time while that explains the residual better:
@@ -296,8 +299,19 @@ def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str
     hour = day_type_hour(data.times, zone)
     heat = np.zeros((len(data), N_DAY_TYPES * 24))
     heat[np.arange(len(data)), hour] = per_unit
+    # A weekly schedule is a pattern that repeats: a day type seen on one date only (the single
+    # Saturday of a short record) would let the "schedule" absorb that day's episode.
+    dates = data.times.tz_convert(zone).normalize()
+    repeated = np.repeat(
+        [dates[hour // 24 == k].nunique() >= MIN_REPEATS for k in range(N_DAY_TYPES)], 24
+    )
+    heat[:, ~repeated] = 0.0
     responses = node_responses(ctx.network, ctx.params, data, node, heat)
-    theta, _ = explain_residual(ctx.residual, responses, ctx.sensitivities)
+    theta = np.zeros(N_DAY_TYPES * 24)
+    if repeated.any():
+        theta[repeated] = explain_residual(
+            ctx.residual, responses[:, repeated], ctx.sensitivities
+        )[0]
     # Neighbouring hours share a schedule; the mean over three damps least squares' spiky
     # solutions, which would otherwise set the peak (each day type wraps around midnight).
     days = theta.reshape(N_DAY_TYPES, 24)
@@ -322,10 +336,10 @@ def _move_edges(
             flipped = schedule.copy()
             flipped[h] = 1.0 - flipped[h]
             trials.append((explained(flipped), h))
-        gain, h = max(trials, default=(0.0, -1))
-        if gain <= value * (1.0 + min_gain):
+        best, h = max(trials, default=(0.0, -1))
+        if best <= value * (1.0 + min_gain):
             return schedule
-        schedule[h], value = 1.0 - schedule[h], gain
+        schedule[h], value = 1.0 - schedule[h], best
 
 
 def ventilation_schedule(ctx: Context) -> Extension | Skipped:
