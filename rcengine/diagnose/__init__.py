@@ -40,16 +40,19 @@ __all__ = ["DiagnoseSettings", "Report", "diagnose"]
 @dataclass(frozen=True)
 class DiagnoseSettings:
     """train_fraction: share of the record (whole days) used for fitting, the rest is the test;
-    preset: estimator preset for every refit; confirm: candidates refitted per round after the
-    first (which refits them all); min_improvement: relative test-RMSE cut an extension must
-    bring, and min_improvement_k in kelvin (0.1 K, a room sensor's accuracy: smaller gains are
-    no evidence of physics); bic_margin: how much the effective-n BIC must drop; max_rounds:
+    preset: estimator preset of the baseline and of every refit that adds inputs;
+    structural_preset: of refits that add a state (a new capacitor brings new basins, which the
+    longer GA of "default" explores); confirm: candidates refitted per round after the first
+    (which refits them all); min_improvement: relative test-RMSE cut an extension must bring,
+    and min_improvement_k in kelvin (0.1 K, a room sensor's accuracy: smaller gains are no
+    evidence of physics); bic_margin: how much the effective-n BIC must drop; max_rounds:
     forward-selection rounds; baseline_starts: independent searches for the baseline fit (best
     kept); workers: processes for the refits of a round (default: every core); effects: the
     candidate ids to consider (default: the whole vocabulary)."""
 
     train_fraction: float = 0.5
     preset: str = "study"
+    structural_preset: str = "default"
     confirm: int = 3
     min_improvement: float = 0.10
     min_improvement_k: float = 0.1
@@ -277,7 +280,7 @@ def _round(
                 e.network,
                 e.signals,
                 splits[e.effect],
-                settings.preset,
+                settings.structural_preset if e.structural else settings.preset,
                 settings.random_state,
                 [{**current.params, **e.neutral}, dict(current.params)],
             )
