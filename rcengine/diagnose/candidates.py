@@ -275,9 +275,18 @@ def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> LearntSch
     Learnt on both clocks a building may keep (civil time or standard time all year) unless the
     model already plays a schedule on one; the clock whose schedule explains more is kept.
     """
-    clocks = (ctx.signals.schedule_clock,) if ctx.signals.schedules else CLOCKS
-    learnt = [_schedule_on_clock(ctx, node, per_unit, clock) for clock in clocks]
+    learnt = [_schedule_on_clock(ctx, node, per_unit, clock) for clock in _clocks(ctx)]
     return max(learnt, key=lambda s: s.explained)
+
+
+def _clocks(ctx: Context) -> tuple[str, ...]:
+    """The clocks worth learning on: the model's own if it plays a schedule already, only the
+    civil one when the training period has no daylight saving (both read the same hours)."""
+    if ctx.signals.schedules:
+        return (ctx.signals.schedule_clock,)
+    tz = ctx.building.location.timezone
+    standard = day_type_hour(ctx.data.times, clock_zone(tz, "standard"))
+    return ("local",) if np.array_equal(day_type_hour(ctx.data.times, tz), standard) else CLOCKS
 
 
 def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str) -> LearntSchedule:
