@@ -30,12 +30,13 @@ from scipy.integrate import solve_ivp
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
-from rcengine.estimate import Estimator, search, settings_for
+from rcengine.estimation import settings_for
+from rcengine.estimation.estimator import Estimator, search
+from rcengine.estimation.search_space import SearchSpace
 from rcengine.exceptions import ConvergenceWarning
 from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
 from rcengine.network import CompiledNetwork, RCNetwork
-from rcengine.search_space import SearchSpace
 from rcengine.signals import prepare
 from rcengine.simulate import modal_system, simulate_modal
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import pandas as pd
 
 from rcengine.dataset import Dataset
-from rcengine.estimate import Estimator
+from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning
 from rcengine.network import Parameter, RCNetwork
 

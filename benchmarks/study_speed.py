@@ -23,8 +23,8 @@ from pathlib import Path
 
 from rcengine.building import Building
 from rcengine.io.timeseries import read_timeseries
-from rcengine.study import StudySettings, progress_bar, run_study
-from rcengine.study_report import write_study
+from rcengine.study.report import write_study
+from rcengine.study.run import StudySettings, progress_bar, run_study
 
 ROOT = Path(__file__).resolve().parents[1]
 OFFICE = ROOT / "data" / "energyplus" / "office"

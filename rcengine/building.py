@@ -7,7 +7,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .exceptions import BuildingError
+from rcengine.exceptions import BuildingError
 
 
 @dataclass(frozen=True)

@@ -11,14 +11,14 @@ from typing import Annotated
 
 import typer
 
-from .building import Building
-from .estimate import PRESETS, Estimator
-from .exceptions import ConvergenceWarning, RCEngineError
-from .forecast import forecast
-from .io.timeseries import read_timeseries, write_timeseries
-from .models import available_models, get_model
-from .params import ParameterSet
-from .signals import SignalOptions, prepare
+from rcengine.building import Building
+from rcengine.estimation import PRESETS, Estimator
+from rcengine.exceptions import ConvergenceWarning, RCEngineError
+from rcengine.forecast import forecast
+from rcengine.io.timeseries import read_timeseries, write_timeseries
+from rcengine.models import available_models, get_model
+from rcengine.parameter_set import ParameterSet
+from rcengine.signals import SignalOptions, prepare
 
 app = typer.Typer(
     help="Grey-box RC thermal models of buildings: calibrate, forecast, diagnose.",
@@ -149,9 +149,9 @@ def diagnose(
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
 ) -> None:
     """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
-    from .diagnose import DiagnoseSettings
-    from .diagnose import diagnose as run_diagnosis
-    from .diagnose.html import render
+    from rcengine.diagnose import DiagnoseSettings
+    from rcengine.diagnose import diagnose as run_diagnosis
+    from rcengine.diagnose.html import render
 
     def run() -> None:
         b = Building.from_json(building)
@@ -197,8 +197,8 @@ def study(
     import os
     import time
 
-    from .study import StudySettings, progress_bar, run_study
-    from .study_report import write_study
+    from rcengine.study.report import write_study
+    from rcengine.study.run import StudySettings, progress_bar, run_study
 
     if preset not in PRESETS:
         fail(f"invalid preset {preset!r}; choose from {sorted(PRESETS)}")

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .columns import T_IN
-from .exceptions import DataValidationError, ModelError, Problem
+from rcengine.columns import T_IN
+from rcengine.exceptions import DataValidationError, ModelError, Problem
 
 
 @dataclass(frozen=True)

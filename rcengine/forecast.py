@@ -12,12 +12,12 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .columns import Q_HVAC
-from .dataset import Dataset
-from .exceptions import DataValidationError, ModelError, Problem
-from .kalman import FilterResult, kalman_filter
-from .network import CompiledNetwork
-from .statespace import DiscreteStateSpace
+from rcengine.columns import Q_HVAC
+from rcengine.dataset import Dataset
+from rcengine.exceptions import DataValidationError, ModelError, Problem
+from rcengine.kalman import FilterResult, kalman_filter
+from rcengine.network import CompiledNetwork
+from rcengine.statespace import DiscreteStateSpace
 
 DEFAULT_HISTORY_H = 48.0
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .statespace import DiscreteStateSpace
+from rcengine.statespace import DiscreteStateSpace
 
 PROCESS_STD_K_PER_SQRT_H = 0.1
 MEASUREMENT_STD_K = 0.1

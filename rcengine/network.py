@@ -36,8 +36,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .exceptions import ModelError
-from .statespace import DiscreteStateSpace, discretize
+from rcengine.exceptions import ModelError
+from rcengine.statespace import DiscreteStateSpace, discretize
 
 Value = str | float  # a parameter name, or a fixed number in SI units
 

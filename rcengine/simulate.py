@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .network import RCMatrices
+from rcengine.network import RCMatrices
 
 # Elements of a (steps × population × modes) work block; bounds memory for long series.
 _BLOCK_ELEMENTS = 100_000

@@ -3,7 +3,7 @@
 - measurement rows ↔ the engine's frame (UTC ``DatetimeIndex`` named ``time``, float columns of
   the contract, NaN for missing values);
 - building rows → :class:`~rcengine.building.Building`;
-- parameter-set rows ↔ :class:`~rcengine.params.ParameterSet` (the stored document is exactly
+- parameter-set rows ↔ :class:`~rcengine.parameter_set.ParameterSet` (the stored document is exactly
   the ``params.json`` that ``rcengine predict`` reads).
 """
 
@@ -24,7 +24,7 @@ from rcengine.building import Building
 from rcengine.columns import COLUMNS, NUMERIC_COLUMNS, TIME
 from rcengine.exceptions import DataValidationError, Problem
 from rcengine.io.timeseries import format_times
-from rcengine.params import ParameterSet
+from rcengine.parameter_set import ParameterSet
 
 from . import repository
 from .models import ParameterSetRecord

@@ -27,12 +27,12 @@ import pandas as pd
 
 from rcengine.building import Building
 from rcengine.columns import T_IN
-from rcengine.estimate import Estimator
+from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning, RCEngineError
 from rcengine.forecast import forecast
 from rcengine.metrics import FitMetrics, evaluate
 from rcengine.models import get_model
-from rcengine.params import ParameterSet
+from rcengine.parameter_set import ParameterSet
 from rcengine.signals import prepare
 
 from . import bridge, repository

@@ -27,7 +27,7 @@ from rcengine.forecast import (
 )
 from rcengine.io.timeseries import format_times
 from rcengine.network import CompiledNetwork
-from rcengine.params import ParameterSet
+from rcengine.parameter_set import ParameterSet
 from rcengine.statespace import DiscreteStateSpace
 
 from . import bridge, repository

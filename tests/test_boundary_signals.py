@@ -4,8 +4,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rcengine.ground import ground_temperature
-from rcengine.schedules import (
+from rcengine.signals.ground import ground_temperature
+from rcengine.signals.schedules import (
     clock_zone,
     describe,
     hour_of_week,
@@ -13,7 +13,7 @@ from rcengine.schedules import (
     schedule_signal,
     weekly_profile,
 )
-from rcengine.sky import cloud_cover_from_index, sky_temperature
+from rcengine.signals.sky import cloud_cover_from_index, sky_temperature
 
 
 def test_hour_of_week_is_local_time():

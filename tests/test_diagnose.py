@@ -19,8 +19,8 @@ from rcengine.diagnose.html import render
 from rcengine.diagnose.response import explain_residual, node_responses, on_off_explainer
 from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
-from rcengine.schedules import CLOCKS, clock_zone
 from rcengine.signals import SignalOptions
+from rcengine.signals.schedules import CLOCKS, clock_zone
 from rcengine.simulate import simulate
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
 

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from rcengine.dataset import Dataset
-from rcengine.estimate import Estimator
+from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning, ModelError, NotFittedError
 from rcengine.models import get_model
 
@@ -113,7 +113,7 @@ def test_weekend_gap_is_not_model_error():
     data = Dataset.from_frame(frame).weekdays("UTC")
     assert len(data.segments) == 2
     net = get_model("basic", BUILDING).compile()
-    from rcengine.objective import Objective
+    from rcengine.estimation.objective import Objective
 
     cost = Objective(net, data)(net.as_theta(TRUTH_BASIC))[0]
     assert cost < 1e-7  # exact model + per-segment initial states: no spurious Monday error

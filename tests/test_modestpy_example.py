@@ -9,7 +9,7 @@ import pytest
 
 from benchmarks.modestpy_example import simple_2r1c
 from rcengine.dataset import Dataset
-from rcengine.estimate import Estimator
+from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning
 
 

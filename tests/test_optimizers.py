@@ -5,9 +5,9 @@ import itertools
 import numpy as np
 import pytest
 
-from rcengine import ga, pattern_search
-from rcengine.ga import GASettings
-from rcengine.pattern_search import GPSSettings
+from rcengine.estimation import ga, pattern_search
+from rcengine.estimation.ga import GASettings
+from rcengine.estimation.pattern_search import GPSSettings
 
 TARGET = np.array([0.3, 0.7, 0.55])
 

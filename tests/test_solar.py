@@ -10,13 +10,13 @@ import pytest
 from pvlib.iotools import read_epw
 
 from rcengine.building import Building, Location, Surface
-from rcengine.solar import (
+from rcengine.signals.solar import (
     clear_sky_ghi as clear_ghi,
 )
-from rcengine.solar import (
+from rcengine.signals.solar import (
     clear_sky_index as clear_index,
 )
-from rcengine.solar import (
+from rcengine.signals.solar import (
     decompose_ghi,
     glazing_diffuse_iam,
     glazing_iam,

@@ -10,12 +10,12 @@ import pandas as pd
 import pytest
 
 from rcengine.building import Building
-from rcengine.estimate import EstimatorSettings
-from rcengine.ga import GASettings
+from rcengine.estimation import EstimatorSettings
+from rcengine.estimation.ga import GASettings
+from rcengine.estimation.pattern_search import GPSSettings
 from rcengine.io.timeseries import read_timeseries
-from rcengine.pattern_search import GPSSettings
-from rcengine.study import StudySettings, run_study, sky_class, tables
-from rcengine.study_report import write_study
+from rcengine.study.report import write_study
+from rcengine.study.run import StudySettings, run_study, sky_class, tables
 
 TZ = "Europe/Rome"
 # Friday 18 – Monday 21 November 2016: the Complete period predicts all four days, the Selected

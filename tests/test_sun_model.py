@@ -10,12 +10,12 @@ import pytest
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
-from rcengine.estimate import Estimator
+from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning
 from rcengine.models import get_model
 from rcengine.network import RCNetwork
 from rcengine.signals import prepare
-from rcengine.solar import solar_gains
+from rcengine.signals.solar import solar_gains
 
 from .synthetic import TRUTH_SUN, basic_reference, weather_and_gains, with_recorded_weather
 

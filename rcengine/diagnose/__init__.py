@@ -23,16 +23,16 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from ..building import Building
-from ..models import get_model
-from ..parallel import one_blas_thread
-from ..signals import SignalOptions
-from .candidates import CANDIDATES, Context, Extension, Skipped
-from .fitting import Fit, FitJob, fit_many, residual_at, split_data
-from .locate import summarize
-from .report import Finding, Report, explain, judge, screened_only
-from .screen import screen
-from .whiteness import ljung_box
+from rcengine.building import Building
+from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped
+from rcengine.diagnose.fitting import Fit, FitJob, fit_many, residual_at, split_data
+from rcengine.diagnose.locate import summarize
+from rcengine.diagnose.report import Finding, Report, explain, judge, screened_only
+from rcengine.diagnose.screen import screen
+from rcengine.diagnose.whiteness import ljung_box
+from rcengine.models import get_model
+from rcengine.parallel import one_blas_thread
+from rcengine.signals import SignalOptions
 
 __all__ = ["DiagnoseSettings", "Report", "diagnose"]
 

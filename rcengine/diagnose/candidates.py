@@ -15,11 +15,19 @@ from functools import cached_property
 import numpy as np
 import pandas as pd
 
-from ..building import Building
-from ..columns import Q_HVAC, T_OUT, WIND_SPEED
-from ..dataset import Dataset
-from ..network import Parameter, RCNetwork
-from ..schedules import (
+from rcengine.building import Building
+from rcengine.columns import Q_HVAC, T_OUT, WIND_SPEED
+from rcengine.dataset import Dataset
+from rcengine.diagnose.response import (
+    explain_residual,
+    node_responses,
+    on_off_explainer,
+    parameter_sensitivities,
+)
+from rcengine.network import Parameter, RCNetwork
+from rcengine.signals import SignalOptions
+from rcengine.signals.derived import T_REF_C
+from rcengine.signals.schedules import (
     CLOCKS,
     N_DAY_TYPES,
     clock_zone,
@@ -28,14 +36,7 @@ from ..schedules import (
     on_hours,
     weekly_from_day_types,
 )
-from ..signals import T_REF_C, SignalOptions
-from ..solar import orientation_key
-from .response import (
-    explain_residual,
-    node_responses,
-    on_off_explainer,
-    parameter_sensitivities,
-)
+from rcengine.signals.solar import orientation_key
 
 AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
 # Shares of the learnt profile's peak tried as the on/off threshold of a schedule.

@@ -8,16 +8,16 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..building import Building
-from ..dataset import Dataset
-from ..estimate import Estimator
-from ..exceptions import ConvergenceWarning
-from ..kalman import kalman_filter
-from ..metrics import rmse
-from ..network import CompiledNetwork, RCNetwork
-from ..objective import Objective
-from ..parallel import process_pool
-from ..signals import SignalOptions, prepare
+from rcengine.building import Building
+from rcengine.dataset import Dataset
+from rcengine.estimation.estimator import Estimator
+from rcengine.estimation.objective import Objective
+from rcengine.exceptions import ConvergenceWarning
+from rcengine.kalman import kalman_filter
+from rcengine.metrics import rmse
+from rcengine.network import CompiledNetwork, RCNetwork
+from rcengine.parallel import process_pool
+from rcengine.signals import SignalOptions, prepare
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .locate import DAYS, hour_weekday
-from .report import Finding, Report
+from rcengine.diagnose.locate import DAYS, hour_weekday
+from rcengine.diagnose.report import Finding, Report
 
 _STYLE = """
 body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;color:#222;line-height:1.45}

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..building import Building
-from ..columns import GHI, Q_HVAC, T_OUT, WIND_SPEED
+from rcengine.building import Building
+from rcengine.columns import GHI, Q_HVAC, T_OUT, WIND_SPEED
 
 DAYS = ["Mon", "Tue", "Wed", "Thu", "Fri", "Sat", "Sun"]
 # Below this mean error [K] a pattern is not worth a sentence.
@@ -23,7 +23,7 @@ def conditions(
     frame: pd.DataFrame, building: Building
 ) -> dict[str, tuple[str, str, np.ndarray, np.ndarray]]:
     """Row masks of contrasting conditions: name → (label_a, label_b, mask_a, mask_b)."""
-    from ..solar import clear_sky_ghi
+    from rcengine.signals.solar import clear_sky_ghi
 
     out: dict[str, tuple[str, str, np.ndarray, np.ndarray]] = {}
     q = frame[Q_HVAC].to_numpy(dtype=float)

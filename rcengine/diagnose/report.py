@@ -8,11 +8,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..building import Building
-from .candidates import Extension
-from .fitting import Fit
-from .locate import summarize
-from .screen import Screen
+from rcengine.building import Building
+from rcengine.diagnose.candidates import Extension
+from rcengine.diagnose.fitting import Fit
+from rcengine.diagnose.locate import summarize
+from rcengine.diagnose.screen import Screen
 
 # What each effect means, in the words of the report.
 MISSING = {

@@ -14,10 +14,10 @@ import numpy as np
 from scipy.optimize import lsq_linear
 from scipy.signal import fftconvolve
 
-from ..dataset import Dataset
-from ..network import RCNetwork
-from ..objective import Objective
-from ..simulate import simulate
+from rcengine.dataset import Dataset
+from rcengine.estimation.objective import Objective
+from rcengine.network import RCNetwork
+from rcengine.simulate import simulate
 
 
 def impulse_response(

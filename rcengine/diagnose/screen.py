@@ -16,14 +16,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import nnls
 
-from ..dataset import Dataset
-from ..estimate import Estimator, EstimatorSettings
-from ..exceptions import ConvergenceWarning
-from ..ga import GASettings
-from ..pattern_search import GPSSettings
-from .candidates import Extension
-from .fitting import Fit, Split
-from .response import node_responses
+from rcengine.dataset import Dataset
+from rcengine.diagnose.candidates import Extension
+from rcengine.diagnose.fitting import Fit, Split
+from rcengine.diagnose.response import node_responses
+from rcengine.estimation import Estimator, EstimatorSettings
+from rcengine.estimation.ga import GASettings
+from rcengine.estimation.pattern_search import GPSSettings
+from rcengine.exceptions import ConvergenceWarning
 
 LOCAL_REFIT = EstimatorSettings(
     GASettings(population=16, generations=4, lhs=True),

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..columns import (
+from rcengine.columns import (
     DHI,
     DNI,
     GHI,

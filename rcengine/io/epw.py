@@ -31,9 +31,9 @@ import numpy as np
 import pandas as pd
 from pvlib.iotools import read_epw as pvlib_read_epw
 
-from ..building import Location
-from ..columns import COLUMNS, DHI, DNI, GHI, MIN_STEP_S, T_OUT, TIME, WIND_SPEED
-from ..exceptions import DataValidationError, Problem
+from rcengine.building import Location
+from rcengine.columns import COLUMNS, DHI, DNI, GHI, MIN_STEP_S, T_OUT, TIME, WIND_SPEED
+from rcengine.exceptions import DataValidationError, Problem
 
 # Contract column ← pvlib's name for the EPW field.
 EPW_FIELDS = {T_OUT: "temp_air", GHI: "ghi", DNI: "dni", DHI: "dhi", WIND_SPEED: "wind_speed"}

@@ -43,8 +43,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..columns import GHI, Q_HVAC, T_IN, T_OUT, TIME
-from .timeseries import validate_frame
+from rcengine.columns import GHI, Q_HVAC, T_IN, T_OUT, TIME
+from rcengine.io.timeseries import validate_frame
 
 SYSLAB_START = "2009-02-05T14:26:00+00:00"
 ARMADILLO_START = "2015-08-19T00:00:00+02:00"

@@ -41,7 +41,7 @@ from typing import IO
 import numpy as np
 import pandas as pd
 
-from ..columns import (
+from rcengine.columns import (
     COLUMNS,
     MAX_STEP_S,
     MIN_STEP_S,
@@ -51,7 +51,7 @@ from ..columns import (
     TEMPERATURE_COLUMNS,
     TIME,
 )
-from ..exceptions import DataValidationError, Problem
+from rcengine.exceptions import DataValidationError, Problem
 
 MAX_PROBLEMS = 1000
 # Data row 0 sits on line 2 of a CSV file, below the header.

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection
 
-from ..building import Building
-from ..exceptions import ModelError
-from ..network import RCNetwork
-from .iso13790 import iso13790_5r1c
-from .simple import r1c1, r2c2
-from .thesis import basic, sun
+from rcengine.building import Building
+from rcengine.exceptions import ModelError
+from rcengine.models.iso13790 import iso13790_5r1c
+from rcengine.models.simple import r1c1, r2c2
+from rcengine.models.thesis import basic, sun
+from rcengine.network import RCNetwork
 
 ModelBuilder = Callable[[Building, Collection[str] | None], RCNetwork]
 

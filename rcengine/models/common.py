@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from ..columns import Q_HVAC, Q_LIGHT, Q_OCC
-from ..network import RCNetwork
+from rcengine.columns import Q_HVAC, Q_LIGHT, Q_OCC
+from rcengine.network import RCNetwork
 
 # The thesis office (§2.4.1) the default bounds of Table 2.3 were set for; bounds on whole-building
 # quantities (c_air [J/K], absorption areas [m²]) scale from it to other buildings.

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from ..building import Building
-from ..columns import GHI, Q_HVAC, Q_LIGHT, Q_OCC, T_OUT
-from ..network import Parameter, RCNetwork
-from .common import has
+from rcengine.building import Building
+from rcengine.columns import GHI, Q_HVAC, Q_LIGHT, Q_OCC, T_OUT
+from rcengine.models.common import has
+from rcengine.network import Parameter, RCNetwork
 
 H_IS_W_M2K = 3.45
 H_MS_W_M2K = 9.1

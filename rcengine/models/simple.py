@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from ..building import Building
-from ..columns import GHI, T_OUT
-from ..network import Parameter, RCNetwork
-from .common import THESIS_VOLUME_M3, add_internal_gains
+from rcengine.building import Building
+from rcengine.columns import GHI, T_OUT
+from rcengine.models.common import THESIS_VOLUME_M3, add_internal_gains
+from rcengine.network import Parameter, RCNetwork
 
 
 def r1c1(building: Building, inputs: Collection[str] | None = None) -> RCNetwork:

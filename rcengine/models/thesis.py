@@ -11,16 +11,16 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from ..building import Building
-from ..columns import GHI, T_OUT
-from ..exceptions import BuildingError
-from ..network import Parameter, RCNetwork
-from .common import (
+from rcengine.building import Building
+from rcengine.columns import GHI, T_OUT
+from rcengine.exceptions import BuildingError
+from rcengine.models.common import (
     THESIS_FLOOR_AREA_M2,
     THESIS_VOLUME_M3,
     THESIS_WALL_AREA_M2,
     add_internal_gains,
 )
+from rcengine.network import Parameter, RCNetwork
 
 SOLAR_WINDOW = "solar_window"
 SOLAR_OPAQUE = "solar_opaque"

@@ -10,7 +10,7 @@ from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
 
 from rcengine.diagnose import DiagnoseSettings
-from rcengine.estimate import PRESETS
+from rcengine.estimation import PRESETS
 from rcengine.models import MODELS
 
 # A shorter admin token is guessable; generated tokens have 43 characters.
@@ -45,7 +45,7 @@ class Settings(BaseSettings):
     scheduler_enabled: bool = True
     training_days: int = Field(7, ge=1, le=365, description="Days fitted by default.")
     model: str = Field("basic", description="Default model of the rcengine library.")
-    preset: str = Field("default", description="Estimator preset of rcengine.estimate.")
+    preset: str = Field("default", description="Estimator preset of rcengine.estimation.estimator.")
     random_state: int = 0
     diagnosis_days: int = Field(
         182,

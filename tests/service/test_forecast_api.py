@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from rcengine.forecast import forecast
-from rcengine.params import ParameterSet
+from rcengine.parameter_set import ParameterSet
 
 from .conftest import json_rows, register, rmse, wait_for_job
 

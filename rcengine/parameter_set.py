@@ -16,14 +16,14 @@ from typing import Any
 
 import pandas as pd
 
-from . import __version__
-from .building import Building
-from .dataset import Dataset
-from .estimate import Estimator
-from .exceptions import ModelError
-from .metrics import evaluate
-from .network import CompiledNetwork, RCNetwork
-from .signals import SignalOptions, prepare
+from rcengine import __version__
+from rcengine.building import Building
+from rcengine.dataset import Dataset
+from rcengine.estimation.estimator import Estimator
+from rcengine.exceptions import ModelError
+from rcengine.metrics import evaluate
+from rcengine.network import CompiledNetwork, RCNetwork
+from rcengine.signals import SignalOptions, prepare
 
 FORMAT_VERSION = 1
 

@@ -11,8 +11,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .exceptions import ModelError
-from .network import CompiledNetwork
+from rcengine.exceptions import ModelError
+from rcengine.network import CompiledNetwork
 
 _LOG_SPAN = 10.0
 

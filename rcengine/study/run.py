@@ -21,17 +21,17 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .building import Building
-from .columns import GHI, Q_HVAC, T_IN
-from .dataset import Dataset
-from .estimate import Estimator, EstimatorSettings
-from .exceptions import ConvergenceWarning
-from .forecast import forecast
-from .metrics import evaluate, rmse
-from .models import get_model
-from .models.thesis import SOLAR_OPAQUE, SOLAR_WINDOW
-from .parallel import process_pool
-from .signals import SignalOptions, prepare
+from rcengine.building import Building
+from rcengine.columns import GHI, Q_HVAC, T_IN
+from rcengine.dataset import Dataset
+from rcengine.estimation import Estimator, EstimatorSettings
+from rcengine.exceptions import ConvergenceWarning
+from rcengine.forecast import forecast
+from rcengine.metrics import evaluate, rmse
+from rcengine.models import get_model
+from rcengine.models.thesis import SOLAR_OPAQUE, SOLAR_WINDOW
+from rcengine.parallel import process_pool
+from rcengine.signals import SignalOptions, prepare
 
 PERIODS = ("complete", "selected")
 
@@ -377,7 +377,7 @@ SKY_CLASSES = ((0.0, 0.4, "overcast"), (0.4, 0.7, "mixed"), (0.7, np.inf, "sunny
 def daily_clearness(frame: pd.DataFrame, building: Building) -> pd.Series:
     """Clearness index of each local day, Σ ghi / Σ clear-sky ghi (Ineichen–Perez), indexed by
     ISO date. [-]"""
-    from .solar import clear_sky_ghi
+    from rcengine.signals.solar import clear_sky_ghi
 
     local_day = frame.index.tz_convert(building.location.timezone).normalize()
     clear = pd.Series(clear_sky_ghi(frame.index, building.location), index=frame.index)

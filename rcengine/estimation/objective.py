@@ -19,10 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .dataset import Dataset
-from .exceptions import DataValidationError, Problem
-from .network import CompiledNetwork
-from .simulate import ModalSystem, free_response, modal_system, simulate_modal
+from rcengine.dataset import Dataset
+from rcengine.exceptions import DataValidationError, Problem
+from rcengine.network import CompiledNetwork
+from rcengine.simulate import ModalSystem, free_response, modal_system, simulate_modal
 
 COSTS = ("mse", "nmse")
 # Relative ridge on the profiled initial states [1/step]; see module docstring.

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .building import Location
+from rcengine.building import Location
 
 KELVIN = 273.15
 SWINBANK = 9.365e-6  # [1/K²]
@@ -42,7 +42,7 @@ def sky_temperature(t_out: np.ndarray, cloud_tenths: np.ndarray) -> np.ndarray:
 def daily_cloud_cover(frame: pd.DataFrame, location: Location) -> np.ndarray:
     """Cloud cover (tenths) per row: the daylight mean of each local day, spread over the day and
     interpolated between days so nights inherit the neighbouring days' cloudiness."""
-    from .solar import clear_sky_ghi
+    from rcengine.signals.solar import clear_sky_ghi
 
     clear = clear_sky_ghi(frame.index, location)
     day = frame.index.tz_convert(location.timezone).normalize()

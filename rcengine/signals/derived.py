@@ -13,12 +13,12 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import pandas as pd
 
-from .building import Building
-from .columns import NUMERIC_COLUMNS, T_OUT, WIND_SPEED
-from .dataset import Dataset
-from .exceptions import ModelError
-from .ground import ground_temperature
-from .schedules import Zone, clock_zone, schedule_signal
+from rcengine.building import Building
+from rcengine.columns import NUMERIC_COLUMNS, T_OUT, WIND_SPEED
+from rcengine.dataset import Dataset
+from rcengine.exceptions import ModelError
+from rcengine.signals.ground import ground_temperature
+from rcengine.signals.schedules import Zone, clock_zone, schedule_signal
 
 # Indoor reference of the air-exchange loss signals: loss ∝ rate × (T_REF − t_out). [°C]
 # The true indoor temperature varies by a few kelvin around it; the fitted gain absorbs the mean.
@@ -54,7 +54,7 @@ Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
 
 
 def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    from .solar import solar_gains
+    from rcengine.signals.solar import solar_gains
 
     return solar_gains(
         frame,
@@ -107,7 +107,7 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
 
 def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
-    from .sky import daily_cloud_cover, sky_temperature
+    from rcengine.signals.sky import daily_cloud_cover, sky_temperature
 
     t_out = frame[T_OUT].to_numpy(dtype=float)
     cover = daily_cloud_cover(frame, building.location)

@@ -2,7 +2,7 @@
 
 In the spirit of ModestPy's GA (Arendt et al. 2018): tournament selection, uniform crossover,
 random-reset and Gaussian mutation, elitism, optional Latin-hypercube start. Genes are the
-parameters mapped to [0, 1] by :mod:`rcengine.search_space`.
+parameters mapped to [0, 1] by :mod:`rcengine.estimation.search_space`.
 """
 
 from __future__ import annotations

@@ -21,8 +21,8 @@ import numpy as np
 import pandas as pd
 from pvlib import atmosphere, clearsky, iam, irradiance, solarposition
 
-from .building import Building, Location, Surface
-from .columns import DHI, DNI, GHI
+from rcengine.building import Building, Location, Surface
+from rcengine.columns import DHI, DNI, GHI
 
 DECOMPOSITION_MODELS = ("erbs", "dirint")
 SKY_MODELS = ("isotropic", "perez", "haydavies")

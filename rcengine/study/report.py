@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from . import study_figures as figs
-from .building import Building
-from .study import (
+from rcengine.building import Building
+from rcengine.study import figures as figs
+from rcengine.study.run import (
     StudySettings,
     daily_clearness,
     example,

@@ -2,7 +2,7 @@
 least-squares polish — every population evaluated in one batched simulation.
 
 The procedure of thesis §2.3.3/§2.4.2 (ModestPy: GA to find the basin, GPS to refine it), with
-the unmeasured initial states profiled out exactly (:mod:`rcengine.objective`).
+the unmeasured initial states profiled out exactly (:mod:`rcengine.estimation.objective`).
 """
 
 from __future__ import annotations
@@ -10,63 +10,21 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.optimize
 
-from . import ga, pattern_search
-from .dataset import Dataset
-from .exceptions import ConvergenceWarning, NotFittedError
-from .ga import GASettings
-from .metrics import rmse
-from .network import CompiledNetwork, RCNetwork
-from .objective import Objective, Trajectory
-from .pattern_search import GPSSettings
-from .search_space import SearchSpace
-
-
-@dataclass(frozen=True)
-class EstimatorSettings:
-    """GA and GPS settings; ``polish`` runs a least-squares polish from the GPS optimum and from
-    the next ``polish_starts − 1`` best distinct GA individuals (each a cheap local solve)."""
-
-    ga: GASettings = field(default_factory=GASettings)
-    gps: GPSSettings = field(default_factory=GPSSettings)
-    polish: bool = False
-    polish_starts: int = 1
-
-
-PRESETS: dict[str, EstimatorSettings] = {
-    # Thesis §2.4.2: ModestPy GA 15 generations, tolerance 1e-3; GPS 500 iterations, 1e-6.
-    "thesis": EstimatorSettings(
-        GASettings(population=20, generations=15, tol=1e-3),
-        GPSSettings(max_iter=500, tol=1e-6),
-    ),
-    # ModestPy's examples/simple: GA 5 generations × 20 from a Latin hypercube, then PS.
-    "modestpy": EstimatorSettings(
-        GASettings(population=20, generations=5, lhs=True),
-        GPSSettings(max_iter=500, tol=1e-6),
-    ),
-    # Batched simulation makes populations cheap: GA explores, a short GPS walks to the basin
-    # floor, and Gauss–Newton steps from several distinct basins finish the narrow valleys
-    # that compass moves crawl along.
-    "default": EstimatorSettings(
-        GASettings(population=60, generations=25, tol=1e-4, patience=5, lhs=True),
-        GPSSettings(max_iter=60, tol=1e-4, initial_step=0.05, expand=2.0),
-        polish=True,
-        polish_starts=4,
-    ),
-    # The rolling study's thousands of short fits: a short Latin-hypercube GA only to find the
-    # basins, then least squares from the four best distinct ones (after which compass moves gain
-    # nothing). Half the cost of "default" and a lower training cost more often (docs/study.md).
-    "study": EstimatorSettings(
-        GASettings(population=64, generations=5, tol=1e-4, patience=3, lhs=True),
-        GPSSettings(max_iter=0),
-        polish=True,
-        polish_starts=4,
-    ),
-}
+from rcengine.dataset import Dataset
+from rcengine.estimation import ga, pattern_search
+from rcengine.estimation.ga import GASettings
+from rcengine.estimation.objective import Objective, Trajectory
+from rcengine.estimation.pattern_search import GPSSettings
+from rcengine.estimation.presets import EstimatorSettings, settings_for
+from rcengine.estimation.search_space import SearchSpace
+from rcengine.exceptions import ConvergenceWarning, NotFittedError
+from rcengine.metrics import rmse
+from rcengine.network import CompiledNetwork, RCNetwork
 
 
 @dataclass(frozen=True)
@@ -100,14 +58,6 @@ def search(
     ga_result = ga.minimize(cost, dim, settings.ga, rng, seeds)
     gps_result = pattern_search.minimize(cost, ga_result.x, ga_result.cost, settings.gps)
     return ga_result, gps_result
-
-
-def settings_for(preset: str | EstimatorSettings) -> EstimatorSettings:
-    if isinstance(preset, EstimatorSettings):
-        return preset
-    if preset not in PRESETS:
-        raise ValueError(f"invalid preset {preset!r}; choose from {sorted(PRESETS)}")
-    return PRESETS[preset]
 
 
 class Estimator:
