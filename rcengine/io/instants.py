@@ -1,0 +1,77 @@
+"""One parser for instants: every time a user, a file or a request names (CLI options, dataset
+slices, forecast starts, service query parameters).
+
+Accepted forms: an ISO 8601 instant with a UTC offset (``2017-01-09T06:15:00+01:00``, ``...Z``),
+or — where a building's time zone is given — a local date (``2017-01-09``) or a local date-time
+without offset, read as the wall-clock time in that zone. A ``+`` turned into a space by URL
+decoding (``...T06:15:00 01:00``) is put back. Times outside pandas' nanosecond range
+(1677-09-21 … 2262-04-11) are refused, not wrapped.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pandas as pd
+
+from rcengine.exceptions import DataValidationError, Problem
+
+_PLUS_AS_SPACE = re.compile(r"^(\S+T\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?) (\d{2}:?\d{2})$")
+_DATE_ONLY = re.compile(r"^\d{4}-\d{2}-\d{2}$")
+
+
+def parse_instant(value: object, name: str = "time", timezone: str | None = None) -> pd.Timestamp:
+    """``value`` as a UTC timestamp.
+
+    Parameters
+    ----------
+    value : str, datetime or Timestamp
+        The instant. Text without an offset is accepted only when ``timezone`` is given.
+    name : str
+        What the value is (an option, a column, a query parameter); named in the error.
+    timezone : str, optional
+        IANA zone (the building's) in which dates and offset-less times are read.
+
+    Raises
+    ------
+    DataValidationError : one problem naming ``name`` when the value is no such instant.
+    """
+    text = str(value).strip() if isinstance(value, str) else value
+    if isinstance(text, str):
+        text = _PLUS_AS_SPACE.sub(r"\1+\2", text)
+    try:
+        stamp = pd.Timestamp(text)
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+    if pd.isna(stamp):
+        raise _invalid(value, name, timezone, "")
+    if stamp.tzinfo is None:
+        if timezone is None:
+            raise _invalid(value, name, timezone, " (no UTC offset)")
+        try:
+            stamp = stamp.tz_localize(timezone, ambiguous="raise", nonexistent="raise")
+        except (ValueError, TypeError, OverflowError) as exc:
+            raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+    try:
+        return stamp.tz_convert("UTC").as_unit("ns")
+    except (ValueError, OverflowError) as exc:
+        raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+
+
+def is_local_date(value: object) -> bool:
+    """True for a bare ``YYYY-MM-DD`` (a whole local day, e.g. the end of a period)."""
+    return isinstance(value, str) and bool(_DATE_ONLY.match(value.strip()))
+
+
+def _reason(exc: BaseException) -> str:
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    if "overflow" in text.lower() or "out of bounds" in text.lower():
+        return "outside the supported range 1677-09-22 … 2262-04-11"
+    return text
+
+
+def _invalid(value: object, name: str, timezone: str | None, why: str) -> DataValidationError:
+    forms = "an ISO 8601 time with a UTC offset, e.g. 2017-01-09T06:15:00+01:00"
+    if timezone is not None:
+        forms += f", or a local date such as 2017-01-09 ({timezone})"
+    return DataValidationError([Problem(None, name, f"{name} {value!r} is not {forms}{why}")])
