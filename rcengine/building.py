@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from rcengine.exceptions import BuildingError
+from rcengine.io.jsonable import read_json
 
 
 @dataclass(frozen=True)
@@ -78,23 +78,13 @@ class Building:
 
     @classmethod
     def from_json(cls, path: str | Path) -> Building:
-        try:
-            data = json.loads(Path(path).read_text())
-        except json.JSONDecodeError as exc:
-            raise BuildingError(f"{path}: not valid JSON ({exc})") from exc
-        return cls.from_dict(data)
+        return cls.from_dict(read_json(path, BuildingError))
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
         out["windows"] = [asdict(s) for s in self.windows]
         out["walls"] = [asdict(s) for s in self.walls]
         return out
-
-    def require_windows(self, what: str) -> None:
-        if not self.windows:
-            raise BuildingError(
-                f"{what} needs 'windows' (azimuth, tilt, area) in the building JSON"
-            )
 
 
 def _number(

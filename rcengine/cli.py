@@ -1,5 +1,18 @@
-"""Command line: ``rcengine fit | predict | models`` (CONTRACT.md §3), plus the study and the
-mismatch diagnosis registered by their modules."""
+"""Command line (CONTRACT.md §3); ``rcengine COMMAND --help`` describes each option.
+
+- ``fit DATA -b BUILDING -m MODEL -o PARAMS [--start --end --preset --weekdays --seed
+  --sky-model]``: calibrate MODEL, write its parameter set;
+- ``predict DATA -p PARAMS --start START --hours H -o FORECAST``: forecast ``t_in``;
+- ``models [--json]``: the model library;
+- ``diagnose DATA -b BUILDING [-m MODEL --json REPORT --html REPORT --train-fraction --seed]``:
+  locate the model–data mismatch and name the missing physics;
+- ``study DATA -b BUILDING -o FOLDER [--freefloat --models --start --end --workers --preset
+  --seed]``: the thesis's rolling learn/predict study.
+
+Every ``--start``/``--end`` is an ISO 8601 time with a UTC offset or a local date in the
+building's time zone (``rcengine.io.instants``). Engine errors and bad values end in one line,
+``error: …``, and exit code 2.
+"""
 
 from __future__ import annotations
 
@@ -7,14 +20,18 @@ import json
 import sys
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NoReturn
 
+import pandas as pd
 import typer
 
 from rcengine.building import Building
 from rcengine.estimation import PRESETS, Estimator
-from rcengine.exceptions import ConvergenceWarning, RCEngineError
+from rcengine.estimation.estimator import CRITERIA
+from rcengine.estimation.likelihood import LikelihoodFit
+from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
 from rcengine.forecast import forecast
+from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
 from rcengine.parameter_set import ParameterSet
@@ -30,9 +47,10 @@ DataArg = Annotated[Path, typer.Argument(help="time-series CSV (CONTRACT.md §1)
 BuildingOpt = Annotated[
     Path, typer.Option("--building", "-b", help="building JSON (CONTRACT.md §2)", exists=True)
 ]
+WHEN = "ISO 8601 with UTC offset, or a local date in the building's time zone"
 
 
-def fail(message: str) -> None:
+def fail(message: str) -> NoReturn:
     typer.secho(f"error: {message}", fg=typer.colors.RED, err=True)
     raise typer.Exit(code=2)
 
@@ -45,27 +63,54 @@ def _run(fn):
         fail(str(exc))
 
 
+def _instant(value: str | None, option: str, timezone: str) -> pd.Timestamp | None:
+    """The instant an option names (see ``parse_instant``); a one-line error naming it else."""
+    if value is None:
+        return None
+    try:
+        return parse_instant(value, option, timezone)
+    except DataValidationError as exc:
+        fail("; ".join(p.message for p in exc.problems))
+
+
+def _period(
+    start: str | None, end: str | None, timezone: str
+) -> tuple[pd.Timestamp | None, pd.Timestamp | None]:
+    """``--start`` and ``--end`` as instants, start before end."""
+    first, last = _instant(start, "--start", timezone), _instant(end, "--end", timezone)
+    if first is not None and last is not None and first >= last:
+        fail(f"--start {start!r} is not before --end {end!r}")
+    return first, last
+
+
 @app.command()
 def fit(
     data: DataArg,
     building: BuildingOpt,
     model: Annotated[str, typer.Option("--model", "-m", help="model name, see `rcengine models`")],
     output: Annotated[Path, typer.Option("-o", "--output", help="parameter file to write")],
-    start: Annotated[str | None, typer.Option(help="first time fitted (ISO 8601)")] = None,
-    end: Annotated[str | None, typer.Option(help="end of the fit window (exclusive)")] = None,
+    start: Annotated[str | None, typer.Option(help=f"first time fitted: {WHEN}")] = None,
+    end: Annotated[str | None, typer.Option(help=f"end of the fit (exclusive): {WHEN}")] = None,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "default",
     weekdays: Annotated[bool, typer.Option(help="fit Monday–Friday only")] = False,
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
     sky_model: Annotated[str, typer.Option(help="isotropic | perez | haydavies")] = "isotropic",
+    criterion: Annotated[
+        str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
+    ] = "output_error",
 ) -> None:
     """Calibrate MODEL on DATA and write the parameter set as JSON."""
 
+    if criterion not in CRITERIA:
+        fail(f"invalid criterion {criterion!r}; choose from {list(CRITERIA)}")
+
     def run() -> None:
         b = Building.from_json(building)
+        first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
         net = get_model(model, b, frame.columns)
         options = SignalOptions(sky_model=sky_model)
-        dataset = prepare(frame, b, net.compile().input_names, options).between(start, end)
+        dataset = prepare(frame, b, net.compile().input_names, options).between(first, last)
         if weekdays:
             dataset = dataset.weekdays(b.location.timezone)
         typer.echo(
@@ -74,7 +119,8 @@ def fit(
         )
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConvergenceWarning)
-            est = Estimator(net, preset=preset, random_state=seed).fit(dataset)
+            est = Estimator(net, preset=preset, random_state=seed, criterion=criterion)
+            est.fit(dataset)
         params = ParameterSet.from_estimator(est, dataset, b, model, options)
         params.save(output)
         _print_fit(params, est)
@@ -98,27 +144,51 @@ def _print_fit(params: ParameterSet, est: Estimator) -> None:
         f"NMBE {m['nmbe']:+.2f} % (ASHRAE Guideline 14: {verdict}); "
         f"{est.n_simulations_} simulations in {est.wall_time_s_:.2f} s"
     )
+    if est.likelihood_ is not None:
+        _print_likelihood(est.likelihood_)
+
+
+def _print_likelihood(fit: LikelihoodFit) -> None:
+    """Estimates with standard errors, and the whiteness of the innovations."""
+    u, r = fit.uncertainty, fit.residuals
+    typer.echo(f"−ln L {fit.nll:.2f}, AIC {fit.aic:.1f}; estimate ± standard error:")
+    for name, value, se in zip(u.names, u.estimates, u.std_errors, strict=True):
+        flag = "  ← practically not identifiable" if name in u.non_identifiable else ""
+        typer.echo(f"  {name:<26} {value:>11.4g} ± {se:<9.2g}{flag}")
+    typer.echo("  (process_std_* in K/√h, measurement_std in K)")
+    verdict = "white" if r.white else "NOT white: the model misses dynamics"
+    typer.echo(
+        f"innovations: {r.acf_outside} of {r.acf.size} autocorrelations beyond ±{r.acf_band:.2f}, "
+        f"cumulated periodogram {r.cpgram_deviation:.2f} off the diagonal "
+        f"(band {r.cpgram_band:.2f}): {verdict}"
+    )
 
 
 @app.command()
 def predict(
     data: DataArg,
     params: Annotated[Path, typer.Option("--params", "-p", help="parameter file", exists=True)],
-    start: Annotated[str, typer.Option(help="forecast start (ISO 8601 with offset)")],
+    start: Annotated[str, typer.Option(help=f"forecast start: {WHEN} (the parameter file's)")],
     hours: Annotated[float, typer.Option(help="forecast horizon [h]")],
     output: Annotated[Path, typer.Option("-o", "--output", help="forecast CSV to write")],
+    std: Annotated[
+        bool, typer.Option("--std", help="add t_in_std, the forecast's standard deviation [K]")
+    ] = False,
 ) -> None:
-    """Forecast indoor temperature from START for HOURS; writes time,t_in_pred."""
+    """Forecast indoor temperature from START for HOURS; writes time,t_in_pred[,t_in_std]."""
 
     def run() -> None:
         pset = ParameterSet.load(params)
+        first = _instant(start, "--start", pset.building.location.timezone)
         dataset = pset.prepare(read_timeseries(data))
-        fc = forecast(pset.compiled, pset.values, dataset, start, hours)
-        frame = fc.to_frame()
+        fc = forecast(pset.compiled, pset.values, dataset, first, hours, noise=pset.noise)
+        frame = fc.to_frame(std)
         write_timeseries(frame, output, pset.building.location.timezone)
+        nominal = "" if pset.noise else " (nominal: no fitted noise model)"
         typer.echo(
             f"forecast {len(frame)} steps from {frame.index[0]}: t_in_pred "
-            f"{frame.t_in_pred.min():.2f}–{frame.t_in_pred.max():.2f} °C; wrote {output}"
+            f"{frame.t_in_pred.min():.2f}–{frame.t_in_pred.max():.2f} °C, t_in_std "
+            f"{fc.t_in_std[0]:.2f}→{fc.t_in_std[-1]:.2f} K{nominal}; wrote {output}"
         )
 
     _run(run)
@@ -149,15 +219,14 @@ def diagnose(
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
 ) -> None:
     """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
-    from rcengine.diagnose import DiagnoseSettings
-    from rcengine.diagnose import diagnose as run_diagnosis
+    from rcengine.diagnose import DiagnoseSettings, selection
     from rcengine.diagnose.html import render
 
     def run() -> None:
         b = Building.from_json(building)
         frame = read_timeseries(data)
         settings = DiagnoseSettings(train_fraction=train_fraction, random_state=seed)
-        report = run_diagnosis(frame, b, model, settings, progress=typer.echo)
+        report = selection.diagnose(frame, b, model, settings, progress=typer.echo)
         d = report.to_dict()
         typer.echo(f"baseline {model}: test RMSE {d['baseline']['rmse_test']:.3f} K")
         typer.echo(f"where/when: {d['mismatch']['summary']}")
@@ -187,8 +256,8 @@ def study(
         Path | None, typer.Option(help="free-floating record for the §3.3 validation")
     ] = None,
     models: Annotated[str, typer.Option(help="comma-separated model names")] = "basic,sun",
-    start: Annotated[str | None, typer.Option(help="first predicted day (YYYY-MM-DD)")] = None,
-    end: Annotated[str | None, typer.Option(help="last predicted day, exclusive")] = None,
+    start: Annotated[str | None, typer.Option(help=f"first predicted day: {WHEN}")] = None,
+    end: Annotated[str | None, typer.Option(help=f"end of the predicted days: {WHEN}")] = None,
     workers: Annotated[int, typer.Option(help="processes (0: every core)")] = 0,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "study",
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
@@ -206,12 +275,13 @@ def study(
     def run() -> None:
         started = time.perf_counter()
         b = Building.from_json(building)
+        first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
         settings = StudySettings(
             models=tuple(m.strip() for m in models.split(",") if m.strip()),
             preset=preset,
-            start=start,
-            end=end,
+            start=first,
+            end=last,
             workers=workers or os.cpu_count() or 1,
             random_state=seed,
         )

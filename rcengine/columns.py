@@ -62,3 +62,41 @@ TEMPERATURE_COLUMNS: tuple[str, ...] = (T_IN, T_OUT)
 # Allowed timestep of the CSV [s].
 MIN_STEP_S = 60
 MAX_STEP_S = 3600
+
+# --- derived signals --------------------------------------------------------------------------
+# Model inputs computed from the columns above and the building (rcengine.signals.derived).
+SOLAR_WINDOW = "solar_window"  # Σ window area × irradiance reaching the glazing [W]
+SOLAR_OPAQUE = "solar_opaque"  # Σ opaque area × plane-of-array irradiance [W]
+WIND_LOSS = "wind_loss"  # wind_speed · (t_out − T_REF) [m/s·K]
+VENT_LOSS = "vent_loss"  # ventilation schedule · (t_out − T_REF) [K]
+T_GROUND = "t_ground"  # ground temperature under the floor [°C]
+UNIT = "unit"  # 1 at every row: the signal of a constant heat input [-]
+SKY_DELTA = "sky_delta"  # T_sky − t_out [K]
+# Weekly schedules stored in the signal options, by name; each plays back as sched_<name> [-].
+VENT_SCHEDULE = "vent"
+GAINS_SCHEDULE = "gains"
+
+
+def schedule_signal_name(schedule: str) -> str:
+    """The signal playing back the stored weekly schedule ``schedule``, e.g. ``sched_gains``."""
+    return f"sched_{schedule}"
+
+
+SCHED_GAINS = schedule_signal_name(GAINS_SCHEDULE)
+
+
+def orientation_key(azimuth: float, tilt: float) -> str:
+    """Suffix naming a surface orientation in signal columns, e.g. ``90_90`` (east, vertical).
+
+    Parameters
+    ----------
+    azimuth : clockwise from north. [°]
+    tilt : from horizontal. [°]
+    """
+    return f"{azimuth:g}_{tilt:g}"
+
+
+def solar_orientation_signal(total: str, orientation: str) -> str:
+    """The share of ``total`` (``SOLAR_WINDOW`` or ``SOLAR_OPAQUE``) falling on the surfaces of
+    one orientation (``orientation_key``), e.g. ``solar_window_180_90``. [W]"""
+    return f"{total}_{orientation}"

@@ -16,6 +16,7 @@ import pandas as pd
 
 from rcengine.columns import T_IN
 from rcengine.exceptions import DataValidationError, ModelError, Problem
+from rcengine.io.instants import parse_instant
 
 
 @dataclass(frozen=True)
@@ -58,12 +59,12 @@ class Dataset:
 
     # --- selections ---------------------------------------------------------------------------
     def between(self, start: object = None, end: object = None) -> Dataset:
-        """Rows with start ≤ time < end (either may be None)."""
+        """Rows with start ≤ time < end (either may be None; instants with a UTC offset)."""
         mask = np.ones(len(self.frame), dtype=bool)
         if start is not None:
-            mask &= self.frame.index >= _utc(start)
+            mask &= self.frame.index >= parse_instant(start, "start")
         if end is not None:
-            mask &= self.frame.index < _utc(end)
+            mask &= self.frame.index < parse_instant(end, "end")
         return self._subset(mask)
 
     def weekdays(self, timezone: str) -> Dataset:
@@ -115,12 +116,3 @@ class Dataset:
 def _step_seconds(index: pd.DatetimeIndex) -> np.ndarray:
     """Differences between consecutive times. [s]"""
     return np.diff(index.as_unit("ns").asi8) / 1e9
-
-
-def _utc(value: object) -> pd.Timestamp:
-    ts = pd.Timestamp(value)
-    if ts.tzinfo is None:
-        raise DataValidationError(
-            [Problem(None, "time", f"time {value!r} has no UTC offset; write e.g. +01:00")]
-        )
-    return ts.tz_convert("UTC")

@@ -2,7 +2,11 @@
 inputs (weather forecast, planned HVAC heat).
 
 The state at the forecast start comes from a Kalman filter over the contiguous measurements just
-before it (:mod:`rcengine.kalman`), never from a guess.
+before it (:mod:`rcengine.kalman`), never from a guess. Its covariance, carried through the
+horizon with the process noise, plus the sensor noise, gives ``t_in_std``: the standard deviation
+of the measured indoor temperature about the forecast — the noise model fitted by maximum
+likelihood when given, else the filter's fixed defaults (then only nominal). Parameter
+uncertainty is not included.
 """
 
 from __future__ import annotations
@@ -15,7 +19,8 @@ import pandas as pd
 from rcengine.columns import Q_HVAC
 from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, ModelError, Problem
-from rcengine.kalman import FilterResult, kalman_filter
+from rcengine.io.instants import parse_instant
+from rcengine.kalman import MEASUREMENT_STD_K, FilterResult, Noise, kalman_filter
 from rcengine.network import CompiledNetwork
 from rcengine.statespace import DiscreteStateSpace
 
@@ -25,22 +30,32 @@ DEFAULT_HISTORY_H = 48.0
 @dataclass(frozen=True)
 class Forecast:
     """times: forecast rows (UTC); t_in_pred [°C]; state0: node temperatures at the start [°C];
-    model: the discrete model used; filter: the Kalman pass over the history."""
+    model: the discrete model used; filter: the Kalman pass over the history; t_in_std: standard
+    deviation of the measured t_in about t_in_pred [K] (see the module docstring)."""
 
     times: pd.DatetimeIndex
     t_in_pred: np.ndarray
     state0: np.ndarray
     model: DiscreteStateSpace
     filter: FilterResult
+    t_in_std: np.ndarray
 
-    def to_frame(self) -> pd.DataFrame:
-        return pd.DataFrame({"t_in_pred": self.t_in_pred}, index=self.times.rename("time"))
+    def to_frame(self, std: bool = False) -> pd.DataFrame:
+        """``t_in_pred`` by time (CONTRACT.md §3), and ``t_in_std`` beside it if ``std``."""
+        columns = {"t_in_pred": self.t_in_pred} | ({"t_in_std": self.t_in_std} if std else {})
+        return pd.DataFrame(columns, index=self.times.rename("time"))
 
 
 def initial_state(
-    model: DiscreteStateSpace, data: Dataset, start: pd.Timestamp, history_h: float
+    model: DiscreteStateSpace,
+    data: Dataset,
+    start: pd.Timestamp,
+    history_h: float,
+    process_cov: np.ndarray | None = None,
+    measurement_std: float = MEASUREMENT_STD_K,
 ) -> FilterResult:
-    """Kalman filter over the contiguous rows in [start − history_h, start) ending at start."""
+    """Kalman filter over the contiguous rows in [start − history_h, start) ending at start
+    (``process_cov`` [K²] and ``measurement_std`` [K] as in :func:`kalman_filter`)."""
     past = data.frame.loc[(data.frame.index < start)]
     past = past.loc[past.index >= start - pd.Timedelta(hours=history_h)]
     step = pd.Timedelta(seconds=data.step_s)
@@ -64,7 +79,21 @@ def initial_state(
             [Problem(None, "t_in", f"no measured t_in in the {history_h:g} h before {start}")]
         )
     u = Dataset(rows, data.step_s).inputs(model.input_names)
-    return kalman_filter(model, u, measured)
+    return kalman_filter(
+        model, u, measured, process_cov=process_cov, measurement_std=measurement_std
+    )
+
+
+def output_std(model: DiscreteStateSpace, filtered: FilterResult, steps: int) -> np.ndarray:
+    """Standard deviation of the measured output over an open-loop horizon [K]: the filter's state
+    covariance at the start, carried by P ← A P Aᵀ + Q, seen through y = C x + v:
+    var y[k] = C P[k] Cᵀ + R."""
+    std = np.empty(steps)
+    P = filtered.covariance
+    for k in range(steps):
+        std[k] = np.sqrt(model.C @ P @ model.C + filtered.measurement_var)
+        P = model.A @ P @ model.A.T + filtered.process_cov
+    return std
 
 
 def future_inputs(
@@ -96,17 +125,25 @@ def forecast(
     start: object,
     hours: float,
     history_h: float = DEFAULT_HISTORY_H,
+    noise: Noise | None = None,
 ) -> Forecast:
-    """Indoor temperature for ``hours`` from ``start`` using the inputs already in ``data``."""
-    start = _timestamp(start)
+    """Indoor temperature for ``hours`` from ``start`` using the inputs already in ``data``;
+    ``noise``: the fitted noise model (``Estimator.noise_``), None for the filter's defaults."""
+    start = parse_instant(start, "start")
     steps = round(hours * 3600.0 / data.step_s)
     if steps < 1:
         raise ModelError(f"forecast horizon {hours} h is shorter than one step")
     model = network.discrete(params, data.step_s)
-    filtered = initial_state(model, data, start, history_h)
+    if noise is None:
+        filtered = initial_state(model, data, start, history_h)
+    else:
+        process_cov = noise.process_cov(network, params, data.step_s)
+        filtered = initial_state(
+            model, data, start, history_h, process_cov, noise.measurement_std
+        )
     times, u = future_inputs(data, start, steps, model.input_names)
     y, _ = model.simulate(u, filtered.state)
-    return Forecast(times, y, filtered.state, model, filtered)
+    return Forecast(times, y, filtered.state, model, filtered, output_std(model, filtered, steps))
 
 
 def trajectories(
@@ -145,12 +182,3 @@ def trajectories(
     lag = np.arange(horizon)[:, None] - np.arange(horizon)[None, :]
     toeplitz = np.where(lag >= 0, markov[np.maximum(lag, 0)], 0.0)
     return base + candidates @ toeplitz.T
-
-
-def _timestamp(value: object) -> pd.Timestamp:
-    ts = pd.Timestamp(value)
-    if ts.tzinfo is None:
-        raise DataValidationError(
-            [Problem(None, "start", f"start {value!r} needs a UTC offset, e.g. +01:00")]
-        )
-    return ts.tz_convert("UTC")

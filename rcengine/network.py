@@ -382,19 +382,6 @@ class CompiledNetwork:
         Ad, Bd = discretize(A[0], B[0], dt)
         return DiscreteStateSpace(Ad, Bd, C[0], D[0], float(dt), self.state_names, self.input_names)
 
-    def parameter_table(self) -> list[dict]:
-        """Name, unit, bounds and meaning of each parameter, for reports and docs."""
-        return [
-            {
-                "name": p.name,
-                "unit": p.unit,
-                "lower": p.lower,
-                "upper": p.upper,
-                "description": p.description,
-            }
-            for p in self.parameters.values()
-        ]
-
 
 @dataclass(frozen=True)
 class RCMatrices:

@@ -21,6 +21,8 @@ from rcengine.building import Building
 from rcengine.dataset import Dataset
 from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ModelError
+from rcengine.io.jsonable import jsonable, read_json
+from rcengine.kalman import Noise
 from rcengine.metrics import evaluate
 from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.signals import SignalOptions, prepare
@@ -46,6 +48,16 @@ class ParameterSet:
     def compiled(self) -> CompiledNetwork:
         return self.network.compile()
 
+    @property
+    def noise(self) -> Noise | None:
+        """The noise model fitted by maximum likelihood, None for an output-error fit."""
+        if "noise" not in self.fit:
+            return None
+        try:
+            return Noise.from_dict(self.fit["noise"], self.network.states)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"invalid noise model in the parameter file: {exc}") from exc
+
     @classmethod
     def from_estimator(
         cls,
@@ -64,6 +76,7 @@ class ParameterSet:
             "rows": len(data),
             "segments": len(data.segments),
             "preset": estimator.preset if isinstance(estimator.preset, str) else "custom",
+            "criterion": estimator.criterion,
             "cost": estimator.cost,
             "cost_value": estimator.cost_,
             "random_state": estimator.random_state
@@ -78,6 +91,9 @@ class ParameterSet:
                 "per_segment": [s.tolist() for s in estimator.initial_states_],
             },
         }
+        if estimator.likelihood_ is not None:
+            fit["noise"] = estimator.noise_.to_dict(net.state_names)
+            fit["likelihood"] = estimator.likelihood_.to_dict()
         metrics = {"train": evaluate(data.measured, estimator.trajectory_.y).to_dict()}
         return cls(
             model=model,
@@ -140,20 +156,8 @@ class ParameterSet:
             raise ModelError(f"invalid parameter file: {exc}") from exc
 
     def save(self, path: str | Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2, default=_json_default) + "\n")
+        Path(path).write_text(json.dumps(jsonable(self.to_dict()), indent=2) + "\n")
 
     @classmethod
     def load(cls, path: str | Path) -> ParameterSet:
-        try:
-            data = json.loads(Path(path).read_text())
-        except json.JSONDecodeError as exc:
-            raise ModelError(f"{path}: not valid JSON ({exc})") from exc
-        return cls.from_dict(data)
-
-
-def _json_default(value: object) -> object:
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    if hasattr(value, "item"):
-        return value.item()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+        return cls.from_dict(read_json(path, ModelError))

@@ -42,6 +42,61 @@ def discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.
     return E[..., :n, :n], E[..., :n, n:]
 
 
+def discretize_stochastic(
+    A: np.ndarray, B: np.ndarray, diffusion: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Exact discretisation of dx = (A x + B u) dt + dω, E[dω dωᵀ] = Σ dt, batched.
+
+    The noise gathered over one step is Gaussian with covariance Q_d = ∫₀^dt e^{Aτ} Σ e^{Aᵀτ} dτ.
+    Van Loan (1978, Theorem 1) gives it from one matrix exponential; the zero-order hold of B is
+    the transpose of the hold above, so one exponential of a (2n + m) block matrix gives all three:
+
+        exp( [[−A, Σ, 0],      [[·, F₁₂,  0],
+              [ 0, Aᵀ, 0],  =   [0, A_dᵀ, 0],     Q_d = A_d F₁₂.
+              [ 0, Bᵀ, 0]] h)   [0, B_dᵀ, I]]
+
+    (Row block 1 never reaches block 3, so F₁₂ is Van Loan's own.) F₁₂ grows like e^{‖A‖h}
+    while A_d shrinks like e^{−‖A‖h}, so the product loses every digit for a stiff network (a
+    light air node beside a heavy wall: ‖A‖dt of 50 or more). The exponential is therefore taken
+    over h = dt / 2^k with ‖A‖h ≤ ½, and the step doubled k times, each an identity of the
+    recursion x ← A_h x + B_h u + w:
+
+        Q_2h = Q_h + A_h Q_h A_hᵀ,   B_2h = B_h + A_h B_h,   A_2h = A_h².
+
+    Parameters
+    ----------
+    A : (..., n, n) continuous state matrix. [1/s]
+    B : (..., n, m) continuous input matrix. [state unit / (input unit · s)]
+    diffusion : (..., n, n) Σ, the noise intensity. [state unit² / s]
+    dt : step. [s]
+
+    Returns
+    -------
+    A_d (..., n, n), B_d (..., n, m) as :func:`discretize`, and Q_d (..., n, n), symmetric.
+    [state unit² for Q_d]
+    """
+    A = np.asarray(A, dtype=float)
+    B = np.asarray(B, dtype=float)
+    n, m = A.shape[-1], B.shape[-1]
+    norm = float(np.abs(A).sum(axis=-1).max(initial=0.0)) * dt
+    doublings = int(np.ceil(np.log2(norm / 0.5))) if norm > 0.5 else 0
+    h = dt / 2.0**doublings
+    M = np.zeros((*A.shape[:-2], 2 * n + m, 2 * n + m))
+    M[..., :n, :n] = -A * h
+    M[..., :n, n : 2 * n] = np.asarray(diffusion, dtype=float) * h
+    M[..., n : 2 * n, n : 2 * n] = np.swapaxes(A, -1, -2) * h
+    M[..., 2 * n :, n : 2 * n] = np.swapaxes(B, -1, -2) * h
+    E = scipy.linalg.expm(M)
+    A_d = np.swapaxes(E[..., n : 2 * n, n : 2 * n], -1, -2)
+    B_d = np.swapaxes(E[..., 2 * n :, n : 2 * n], -1, -2)
+    Q = A_d @ E[..., :n, n : 2 * n]
+    for _ in range(doublings):
+        Q = Q + A_d @ Q @ np.swapaxes(A_d, -1, -2)
+        B_d = B_d + A_d @ B_d
+        A_d = A_d @ A_d
+    return A_d, B_d, 0.5 * (Q + np.swapaxes(Q, -1, -2))
+
+
 @dataclass(frozen=True)
 class DiscreteStateSpace:
     """x[k+1] = A x[k] + B u[k],  y[k] = C x[k] + D u[k]  for one parameter set.

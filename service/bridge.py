@@ -10,7 +10,6 @@
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Sequence
 from datetime import datetime
 from typing import Any
@@ -22,53 +21,16 @@ from sqlalchemy.orm import Session
 
 from rcengine.building import Building
 from rcengine.columns import COLUMNS, NUMERIC_COLUMNS, TIME
-from rcengine.exceptions import DataValidationError, Problem
-from rcengine.io.timeseries import format_times
+from rcengine.io.jsonable import jsonable
 from rcengine.parameter_set import ParameterSet
 
 from . import repository
 from .models import ParameterSetRecord
 
-# "2017-01-09T06:15:00 01:00": a '+' sent unescaped in a query string arrives as a space.
-_PLUS_AS_SPACE = re.compile(r"^(\S+T\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?) (\d{2}:?\d{2})$")
-
 
 # --- times ------------------------------------------------------------------------------------
-def parse_instant(text: str, name: str) -> pd.Timestamp:
-    """An ISO 8601 time with a UTC offset, as a UTC timestamp.
-
-    Raises
-    ------
-    DataValidationError : naming ``name`` when the text is not such a time.
-    """
-    text = _PLUS_AS_SPACE.sub(r"\1+\2", text.strip())
-    try:
-        stamp = pd.Timestamp(text)
-    except ValueError:
-        stamp = None
-    if stamp is None or pd.isna(stamp) or stamp.tzinfo is None:
-        raise DataValidationError(
-            [
-                Problem(
-                    None,
-                    name,
-                    f"{name} {text!r} is not an ISO 8601 time with a UTC offset, e.g. "
-                    "2017-01-09T06:15:00+01:00 (write '+' as %2B in a URL)",
-                )
-            ]
-        )
-    return stamp.tz_convert("UTC")
-
-
 def to_datetime(stamp: pd.Timestamp) -> datetime:
     return stamp.tz_convert("UTC").to_pydatetime()
-
-
-def local_time(value: datetime | pd.Timestamp | None, timezone: str) -> str | None:
-    """One time as ISO 8601 with the offset of ``timezone`` (None stays None)."""
-    if value is None:
-        return None
-    return format_times(pd.DatetimeIndex([pd.Timestamp(value)]), timezone)[0]
 
 
 # --- measurements -----------------------------------------------------------------------------
@@ -125,7 +87,7 @@ def parameter_set_record(
     pset: ParameterSet, building_id: int, job_id: int | None, reason: str | None
 ) -> ParameterSetRecord:
     """A row holding ``pset`` (status and ``is_current`` are set when it is stored)."""
-    document = json.loads(json.dumps(pset.to_dict(), default=_plain))
+    document = json.loads(json.dumps(pset.to_dict(), default=jsonable))
     holdout = pset.metrics.get("holdout") or {}
     return ParameterSetRecord(
         building_id=building_id,
@@ -140,10 +102,3 @@ def parameter_set_record(
         engine_version=pset.engine_version,
         document=document,
     )
-
-
-def _plain(value: object) -> object:
-    """numpy scalars and arrays inside a parameter-set document, as JSON values."""
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

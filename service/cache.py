@@ -58,6 +58,3 @@ class LRUCache(Generic[V]):
                     self._items.popitem(last=False)
         pending.set_result(value)
         return value
-
-    def __len__(self) -> int:
-        return len(self._items)

@@ -10,20 +10,18 @@ held-out day the way the service forecasts (Kalman-filtered state from the rows 
 loop over the day's inputs); the new set becomes current only if its RMSE there is no worse.
 A failed fit or a worse set never replaces the current one; both are stored with their reason.
 
-``run_job`` is the entry point of the worker process; ``execute`` runs a job in the caller's
-process (the CLI, and the server when ``RCSERVICE_WORKERS=0``).
+:func:`work` is what a calibration job runs (the job itself is handled by ``service.jobs``).
 """
 
 from __future__ import annotations
 
-import logging
-import time
 import warnings
 from dataclasses import dataclass, replace
 from datetime import datetime
 from typing import Any
 
 import pandas as pd
+from sqlalchemy.orm import Session
 
 from rcengine.building import Building
 from rcengine.columns import T_IN
@@ -38,12 +36,11 @@ from rcengine.signals import prepare
 from . import bridge, repository
 from .core.db import Database
 from .errors import CalibrationError
-from .models import FAILED, PROMOTED, REJECTED, SUCCEEDED
+from .models import PROMOTED, REJECTED, JobRecord
 
 HOLDOUT_H = 24.0
 # Measured training data needed at least, besides the held-out day. [h]
 MIN_TRAINING_H = 24.0
-log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -74,7 +71,7 @@ class Window:
 
 
 @dataclass(frozen=True)
-class Outcome:
+class Calibrated:
     """A fitted set, its and the current set's held-out metrics, and the decision."""
 
     parameter_set: ParameterSet
@@ -86,102 +83,68 @@ class Outcome:
     reason: str
     warnings: list[str]
 
+    @property
+    def outcome(self) -> str:
+        return PROMOTED if self.promote else REJECTED
 
-def run_job(database_url: str, job_id: int, options: CalibrationOptions) -> None:
-    """Worker entry: its own database engine, then :func:`execute`."""
-    db = Database(database_url)
-    try:
-        execute(db, job_id, options)
-    finally:
-        db.dispose()
-
-
-def execute(db: Database, job_id: int, options: CalibrationOptions) -> str:
-    """Run a queued job to its end; returns its final status. Never raises for a failed fit."""
-    started = time.perf_counter()
-    with db.write() as session:
-        job = repository.start_job(session, job_id)
-        building_id, model, days = job.building_id, job.model, job.days
-    log.info("calibration started", extra={"job_id": job_id, "building_id": building_id})
-    try:
-        outcome = calibrate(db, building_id, model, days, options)
-    except Exception as exc:  # every failure is stored with its reason; the current set stays
-        error = describe(exc)
-        with db.write() as session:
-            repository.finish_job(session, job_id, FAILED, error=error)
-        log.warning(
-            "calibration failed",
-            extra={"job_id": job_id, "building_id": building_id, "error": error},
-            exc_info=not isinstance(exc, RCEngineError | CalibrationError),
-        )
-        return FAILED
-    with db.write() as session:
+    def save(self, session: Session, job: JobRecord) -> dict[str, Any]:
+        """Store the set (current if promoted, else rejected with its reason); the job's
+        details."""
         record = repository.add_parameter_set(
             session,
             bridge.parameter_set_record(
-                outcome.parameter_set,
-                building_id,
-                job_id,
-                None if outcome.promote else outcome.reason,
+                self.parameter_set, job.building_id, job.id, None if self.promote else self.reason
             ),
-            outcome.promote,
+            self.promote,
         )
-        details = _details(outcome, record.id, time.perf_counter() - started)
-        repository.finish_job(
-            session,
-            job_id,
-            SUCCEEDED,
-            outcome=PROMOTED if outcome.promote else REJECTED,
-            details=details,
-        )
-    log.info(
-        "calibration finished",
-        extra={
-            "job_id": job_id,
-            "building_id": building_id,
-            "outcome": PROMOTED if outcome.promote else REJECTED,
+        fit = self.parameter_set.fit
+        return {
             "parameter_set_id": record.id,
-            "rmse_holdout": outcome.holdout_new.rmse,
-            "duration_s": round(time.perf_counter() - started, 3),
-        },
-    )
-    return SUCCEEDED
+            "reason": self.reason,
+            "window": self.window.to_dict(),
+            "training_rows": fit["rows"],
+            "holdout": {
+                "new": self.holdout_new.to_dict(),
+                "current": None if self.holdout_current is None else self.holdout_current.to_dict(),
+                "current_parameter_set_id": self.current_id,
+            },
+            "n_simulations": fit["n_simulations"],
+            "fit_wall_time_s": fit["wall_time_s"],
+            "warnings": self.warnings,
+        }
 
 
-def calibrate(
-    db: Database, building_id: int, model: str, days: int, options: CalibrationOptions
-) -> Outcome:
-    """Fit, score against the current set on the held-out day, decide."""
+def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrated:
+    """Fit on the job's days, score against the current set on the held-out day, decide."""
     with db.session() as session:
-        building_row = repository.get_building(session, building_id)
+        building_row = repository.get_building(session, job.building_id)
         building = bridge.building_of(building_row.description)
         window = _window(
             building_row.last_measured_at,
             building_row.step_s,
-            days,
+            job.days,
             options.holdout_h,
         )
-        frame = bridge.load_frame(session, building_id, window.train_start, window.end)
-        current = repository.current_parameter_set(session, building_id)
+        frame = bridge.load_frame(session, job.building_id, window.train_start, window.end)
+        current = repository.current_parameter_set(session, job.building_id)
         current_set = None if current is None else bridge.parameter_set_of(current)
     training = frame.loc[frame.index < window.holdout_start]
     _check_enough(training, window)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConvergenceWarning)
-        fitted = fit_parameter_set(training, building, model, options)
+        fitted = fit_parameter_set(training, building, job.model, options)
     new_score = holdout_score(fitted, frame, window)
     fitted = replace(fitted, metrics={**fitted.metrics, "holdout": new_score.to_dict()})
     current_score, note = _score_current(current_set, frame, window)
     promote = current_score is None or new_score.rmse <= current_score.rmse
-    reason = note or _verdict(new_score, current_score)
-    return Outcome(
+    return Calibrated(
         fitted,
         window,
         new_score,
         current_score,
         None if current is None else current.id,
         promote,
-        reason,
+        note or _verdict(new_score, current_score),
         [str(w.message) for w in caught],
     )
 
@@ -204,11 +167,6 @@ def holdout_score(pset: ParameterSet, frame: pd.DataFrame, window: Window) -> Fi
     predicted = forecast(pset.compiled, pset.values, data, window.holdout_start, hours)
     measured = frame[T_IN].reindex(predicted.times).to_numpy(dtype=float)
     return evaluate(measured, predicted.t_in_pred)
-
-
-def describe(exc: BaseException) -> str:
-    """A failure as one line for the job record."""
-    return f"{type(exc).__name__}: {exc}"
 
 
 def _window(
@@ -250,24 +208,3 @@ def _verdict(new: FitMetrics, current: FitMetrics | None) -> str:
     return (
         f"held-out day RMSE {new.rmse:.3f} K is {relation} the current set's {current.rmse:.3f} K"
     )
-
-
-def _details(outcome: Outcome, set_id: int, duration_s: float) -> dict[str, Any]:
-    fit = outcome.parameter_set.fit
-    return {
-        "parameter_set_id": set_id,
-        "reason": outcome.reason,
-        "window": outcome.window.to_dict(),
-        "training_rows": fit["rows"],
-        "holdout": {
-            "new": outcome.holdout_new.to_dict(),
-            "current": None
-            if outcome.holdout_current is None
-            else outcome.holdout_current.to_dict(),
-            "current_parameter_set_id": outcome.current_id,
-        },
-        "n_simulations": fit["n_simulations"],
-        "fit_wall_time_s": fit["wall_time_s"],
-        "duration_s": round(duration_s, 3),
-        "warnings": outcome.warnings,
-    }

@@ -83,7 +83,7 @@ def retrain_all() -> None:
 def reset_admin_token() -> None:
     """Replace the generated admin token; prints the new one (the old one stops working)."""
     from .core.db import Database
-    from .core.security import reset_admin_token as reset
+    from .tokens import reset_admin_token as reset
 
     settings = _settings()
     if settings.admin_token is not None:

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 from .core.config import Settings
 from .core.db import Database
-from .core.security import TokenIndex
 from .forecasting import Forecaster
 from .jobs import JobRunner
+from .tokens import TokenIndex
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,7 @@ By default it covers ``diagnosis_days`` before ``end``, clipped to the stored ro
 splits it at a local midnight. A job that raises is stored failed with its error and adds no
 report, so the previous report stays the building's latest.
 
-``run_job`` is the entry point of the worker process; ``execute`` runs a job in the caller's
-process (the server when ``RCSERVICE_WORKERS=0``).
+:func:`work` is what a diagnosis job runs (the job itself is handled by ``service.jobs``).
 """
 
 from __future__ import annotations
@@ -19,25 +18,24 @@ from __future__ import annotations
 import json
 import logging
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
 import pandas as pd
+from sqlalchemy.orm import Session
 
 from rcengine import __version__
 from rcengine.building import Building
 from rcengine.columns import T_IN
 from rcengine.diagnose import DiagnoseSettings, diagnose
-from rcengine.exceptions import DataValidationError, Problem, RCEngineError
+from rcengine.exceptions import DataValidationError, Problem
 
 from . import bridge, repository
-from .calibration import describe
 from .core.db import Database
 from .errors import DiagnosisError
-from .models import FAILED, SUCCEEDED, DiagnosisRecord
+from .models import DiagnosisRecord, JobRecord
 
 # Measured data a diagnosis needs at least: whole days to fit and whole days to test. [d]
 MIN_DIAGNOSIS_DAYS = 2
@@ -46,9 +44,10 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class DiagnosisOptions:
-    """Service-wide engine settings passed to the worker (picklable)."""
+    """Service-wide engine settings passed to the worker (picklable); preset None: the
+    engine's."""
 
-    preset: str = DiagnoseSettings.preset
+    preset: str | None = None
     random_state: int = 0
 
 
@@ -129,75 +128,53 @@ def plan(
     return DiagnosisPlan(start, end, spec.train_fraction, spec.effects)
 
 
-def run_job(database_url: str, job_id: int, options: DiagnosisOptions) -> None:
-    """Worker entry: its own database engine, then :func:`execute`."""
-    db = Database(database_url)
-    try:
-        execute(db, job_id, options)
-    finally:
-        db.dispose()
+@dataclass(frozen=True)
+class Diagnosed:
+    """A finished diagnosis: its report as an unsaved row (diagnoses have no outcome)."""
+
+    record: DiagnosisRecord
+    outcome: None = None
+
+    def save(self, session: Session, job: JobRecord) -> dict[str, Any]:
+        """Store the report, the building's latest from now on; the job's details."""
+        self.record.job_id = job.id
+        repository.add_diagnosis(session, self.record)
+        report = self.record.report
+        return {
+            "diagnosis_id": self.record.id,
+            "window": {
+                "start": pd.Timestamp(self.record.window_start).isoformat(),
+                "end": pd.Timestamp(self.record.window_end).isoformat(),
+            },
+            "accepted": [f["effect"] for f in report["findings"] if f["accepted"]],
+            "rmse_test": {
+                "baseline": report["baseline"]["rmse_test"],
+                "final": report["final"]["rmse_test"],
+            },
+            "final_model": report["final"]["model"],
+        }
 
 
-def execute(db: Database, job_id: int, options: DiagnosisOptions) -> str:
-    """Run a queued diagnosis to its end; returns its final status. Never raises for a failed
-    diagnosis."""
-    started = time.perf_counter()
-    with db.write() as session:
-        job = repository.start_job(session, job_id)
-        building_id, model = job.building_id, job.model
-        job_plan = DiagnosisPlan.from_dict(job.options)
-    context = {"job_id": job_id, "building_id": building_id}
-    log.info("diagnosis started", extra=context)
-    try:
-        record = diagnose_building(
-            db,
-            building_id,
-            model,
-            job_plan,
-            options,
-            lambda step: log.info("diagnosis progress", extra={**context, "step": step}),
-        )
-    except Exception as exc:  # stored with its reason; the previous report stays the latest
-        error = describe(exc)
-        with db.write() as session:
-            repository.finish_job(session, job_id, FAILED, error=error)
-        log.warning(
-            "diagnosis failed",
-            extra={**context, "error": error},
-            exc_info=not isinstance(exc, RCEngineError | DiagnosisError),
-        )
-        return FAILED
-    record.job_id = job_id
-    with db.write() as session:
-        repository.add_diagnosis(session, record)
-        details = _details(record, time.perf_counter() - started)
-        repository.finish_job(session, job_id, SUCCEEDED, details=details)
-    log.info(
-        "diagnosis finished",
-        extra={**context, "diagnosis_id": record.id, "accepted": details["accepted"]},
-    )
-    return SUCCEEDED
-
-
-def diagnose_building(
-    db: Database,
-    building_id: int,
-    model: str,
-    job_plan: DiagnosisPlan,
-    options: DiagnosisOptions,
-    progress: Callable[[str], None],
-) -> DiagnosisRecord:
-    """Diagnose the planned window of the stored rows; the report as an unsaved row."""
+def work(db: Database, job: JobRecord, options: DiagnosisOptions) -> Diagnosed:
+    """Diagnose the window planned for the job on the stored rows."""
+    job_plan = DiagnosisPlan.from_dict(job.options)
     with db.session() as session:
-        row = repository.get_building(session, building_id)
+        row = repository.get_building(session, job.building_id)
         building, step_s = bridge.building_of(row.description), row.step_s
-        frame = bridge.load_frame(session, building_id, job_plan.start, job_plan.end)
+        frame = bridge.load_frame(session, job.building_id, job_plan.start, job_plan.end)
     _check_enough(frame, job_plan, step_s)
     settings = engine_settings(job_plan, options)
-    report, page = diagnose_frame(frame, building, model, settings, progress)
-    return DiagnosisRecord(
-        building_id=building_id,
-        model=model,
+    context = {"job_id": job.id, "building_id": job.building_id}
+    report, page = diagnose_frame(
+        frame,
+        building,
+        job.model,
+        settings,
+        lambda step: log.info("diagnosis progress", extra={**context, "step": step}),
+    )
+    record = DiagnosisRecord(
+        building_id=job.building_id,
+        model=job.model,
         window_start=bridge.to_datetime(frame.index[0]),
         window_end=bridge.to_datetime(frame.index[-1] + pd.Timedelta(seconds=step_s)),
         settings={
@@ -210,13 +187,18 @@ def diagnose_building(
         html=page,
         engine_version=__version__,
     )
+    return Diagnosed(record)
 
 
 def engine_settings(job_plan: DiagnosisPlan, options: DiagnosisOptions) -> DiagnoseSettings:
-    """The service's preset and seed, and the job's choices where it made any."""
-    chosen = {"train_fraction": job_plan.train_fraction, "effects": job_plan.effects}
+    """The service's seed and preset, and the job's choices where it made any (the engine's
+    defaults elsewhere)."""
+    chosen = {
+        "preset": options.preset,
+        "train_fraction": job_plan.train_fraction,
+        "effects": job_plan.effects,
+    }
     return DiagnoseSettings(
-        preset=options.preset,
         random_state=options.random_state,
         **{name: value for name, value in chosen.items() if value is not None},
     )
@@ -245,21 +227,3 @@ def _check_enough(frame: pd.DataFrame, job_plan: DiagnosisPlan, step_s: float) -
             f"measured t_in (whole days to fit, whole days to test); found {measured} row(s) "
             f"in {job_plan.start.isoformat()}–{job_plan.end.isoformat()}"
         )
-
-
-def _details(record: DiagnosisRecord, duration_s: float) -> dict[str, Any]:
-    report = record.report
-    return {
-        "diagnosis_id": record.id,
-        "window": {
-            "start": pd.Timestamp(record.window_start).isoformat(),
-            "end": pd.Timestamp(record.window_end).isoformat(),
-        },
-        "accepted": [f["effect"] for f in report["findings"] if f["accepted"]],
-        "rmse_test": {
-            "baseline": report["baseline"]["rmse_test"],
-            "final": report["final"]["rmse_test"],
-        },
-        "final_model": report["final"]["model"],
-        "duration_s": round(duration_s, 3),
-    }

@@ -101,7 +101,6 @@ class ModelState:
     timezone: str
     model: DiscreteStateSpace
     at: pd.Timestamp
-    local_at: str
     state: np.ndarray
     covariance: np.ndarray
 
@@ -183,9 +182,8 @@ class Forecaster:
             lambda: loaded.compiled.discrete(loaded.pset.values, data.step_s),
         )
         filtered = initial_state(model, data, at, self.history_h)
-        local_at = format_times(pd.DatetimeIndex([at]), key.timezone)[0]
         return ModelState(
-            loaded.info, key.timezone, model, at, local_at, filtered.state, filtered.covariance
+            loaded.info, key.timezone, model, at, filtered.state, filtered.covariance
         )
 
     def _predict(

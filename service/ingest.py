@@ -17,7 +17,7 @@ import pandas as pd
 from rcengine.columns import T_IN, TIME
 from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, Problem
-from rcengine.io.timeseries import FIRST_DATA_LINE, parse_rows, read_timeseries
+from rcengine.io.timeseries import FIRST_DATA_LINE, format_times, parse_rows, read_timeseries
 
 from . import bridge, repository
 from .core.db import Database
@@ -102,19 +102,21 @@ def _check_grid(building: BuildingRecord, frame: pd.DataFrame, first_line: int |
     off_grid = np.flatnonzero(offsets % round(step_s * _NS_PER_S) != 0)
     if not off_grid.size:
         return
-    grid = bridge.local_time(building.grid_origin, building.timezone)
+    shown = off_grid[:100]
+    grid, *times = format_times(
+        pd.DatetimeIndex([building.grid_origin]).append(frame.index[shown]), building.timezone
+    )
     line = "" if first_line is None else " — line {} of the file"
     raise DataValidationError(
         [
             Problem(
                 int(row),
                 TIME,
-                f"time {bridge.local_time(frame.index[row], building.timezone)} is not on the "
-                f"{step_s:g}-s grid of the rows already stored (e.g. {grid}); "
-                "the step of a building's series cannot change (mixed steps)"
+                f"time {time} is not on the {step_s:g}-s grid of the rows already stored "
+                f"(e.g. {grid}); the step of a building's series cannot change (mixed steps)"
                 + line.format(row + (first_line or 0)),
             )
-            for row in off_grid[:100]
+            for row, time in zip(shown, times, strict=True)
         ]
     )
 

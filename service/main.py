@@ -17,10 +17,10 @@ from .api.middleware import BodyLimitMiddleware, RequestLogMiddleware
 from .context import ServiceContext
 from .core.config import Settings
 from .core.db import Database
-from .core.security import TokenIndex, admin_token_hash
 from .forecasting import Forecaster
 from .jobs import JobRunner, fail_interrupted
 from .scheduler import start_scheduler
+from .tokens import TokenIndex, admin_token_hash
 
 log = logging.getLogger(__name__)
 

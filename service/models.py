@@ -61,6 +61,12 @@ class UTCDateTime(TypeDecorator):
         return value.replace(tzinfo=UTC) if value.tzinfo is None else value.astimezone(UTC)
 
 
+def unique_where(name: str, *columns: str, where: str) -> Index:
+    """A unique index over the rows where ``where`` holds (partial, on SQLite and PostgreSQL)."""
+    condition = text(where)
+    return Index(name, *columns, unique=True, sqlite_where=condition, postgresql_where=condition)
+
+
 class Base(DeclarativeBase):
     type_annotation_map: ClassVar[dict[Any, Any]] = {
         datetime: UTCDateTime,
@@ -127,29 +133,44 @@ class JobRecord(Base):
     details: Mapped[dict[str, Any] | None] = mapped_column(JSON)
     options: Mapped[dict[str, Any] | None] = mapped_column(JSON)
 
+    @property
+    def parameter_set_id(self) -> int | None:
+        """The set a succeeded calibration stored."""
+        return (self.details or {}).get("parameter_set_id")
+
+    @property
+    def diagnosis_id(self) -> int | None:
+        """The report a succeeded diagnosis stored."""
+        return (self.details or {}).get("diagnosis_id")
+
     __table_args__ = (
         # At most one queued or running job of each kind per building, enforced by the database.
-        Index(
+        unique_where(
             "uq_jobs_active_building_kind",
             "building_id",
             "kind",
-            unique=True,
-            sqlite_where=text("status IN ('queued', 'running')"),
-            postgresql_where=text("status IN ('queued', 'running')"),
+            where="status IN ('queued', 'running')",
         ),
         Index("ix_jobs_building_created", "building_id", "created_at"),
     )
 
 
-class ParameterSetRecord(Base):
-    """A fitted parameter set: the full ``params.json`` document plus searchable summaries."""
-
-    __tablename__ = "parameter_sets"
+class JobProduct:
+    """Columns of what a job stores for a building: a parameter set, a diagnosis report."""
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
     job_id: Mapped[int | None] = mapped_column(ForeignKey("jobs.id", ondelete="SET NULL"))
     model: Mapped[str] = mapped_column(String(100))
+    engine_version: Mapped[str] = mapped_column(String(32))
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+
+class ParameterSetRecord(JobProduct, Base):
+    """A fitted parameter set: the full ``params.json`` document plus searchable summaries."""
+
+    __tablename__ = "parameter_sets"
+
     status: Mapped[str] = mapped_column(String(16))
     is_current: Mapped[bool] = mapped_column(default=False)
     reason: Mapped[str | None] = mapped_column(Text)
@@ -158,31 +179,24 @@ class ParameterSetRecord(Base):
     rmse_train: Mapped[float | None]
     rmse_holdout: Mapped[float | None]
     metrics: Mapped[dict[str, Any]]
-    engine_version: Mapped[str] = mapped_column(String(32))
     document: Mapped[dict[str, Any]]
-    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+    @property
+    def parameters(self) -> dict[str, Any]:
+        """Value, unit, bounds and description of each parameter (from the document)."""
+        return self.document["parameters"]
 
     __table_args__ = (
-        Index(
-            "uq_parameter_sets_current_building",
-            "building_id",
-            unique=True,
-            sqlite_where=text("is_current"),
-            postgresql_where=text("is_current"),
-        ),
+        unique_where("uq_parameter_sets_current_building", "building_id", where="is_current"),
         Index("ix_parameter_sets_building_created", "building_id", "created_at"),
     )
 
 
-class DiagnosisRecord(Base):
+class DiagnosisRecord(JobProduct, Base):
     """A finished diagnosis: the CONTRACT.md §3 report, its HTML page and what was diagnosed."""
 
     __tablename__ = "diagnoses"
 
-    id: Mapped[int] = mapped_column(Integer, primary_key=True)
-    building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
-    job_id: Mapped[int | None] = mapped_column(ForeignKey("jobs.id", ondelete="SET NULL"))
-    model: Mapped[str] = mapped_column(String(100))
     # First and one-past-last time of the rows diagnosed.
     window_start: Mapped[datetime]
     window_end: Mapped[datetime]
@@ -191,8 +205,6 @@ class DiagnosisRecord(Base):
     report: Mapped[dict[str, Any]]
     # Hundreds of kB: loaded only when the HTML page is asked for.
     html: Mapped[str] = mapped_column(Text, deferred=True)
-    engine_version: Mapped[str] = mapped_column(String(32))
-    created_at: Mapped[datetime] = mapped_column(default=utc_now)
 
     __table_args__ = (Index("ix_diagnoses_building_created", "building_id", "created_at"),)
 

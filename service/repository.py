@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from datetime import datetime
 from typing import Any
 
-from sqlalchemy import Connection, Insert, Row, and_, func, select, update
+from sqlalchemy import Connection, Insert, Row, Select, and_, func, select, update
 from sqlalchemy.dialects import postgresql, sqlite
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
@@ -63,8 +63,44 @@ def get_building(session: Session, building_id: int) -> BuildingRecord:
     return record
 
 
-def list_buildings(session: Session) -> Sequence[BuildingRecord]:
-    return session.scalars(select(BuildingRecord).order_by(BuildingRecord.id)).all()
+def building_summary(session: Session, building_id: int) -> Row:
+    """A building's columns and what it stores (see :func:`building_summaries`)."""
+    row = session.execute(_summaries().where(BuildingRecord.id == building_id)).first()
+    if row is None:
+        raise NotFoundError(f"building {building_id} not found")
+    return row
+
+
+def building_summaries(session: Session) -> Sequence[Row]:
+    """Every building by id: id, name, timezone, description, created_at, step_s,
+    last_measured_time, data_revision, and its stored rows (count, first_time, last_time) and
+    current_parameter_set_id, in one query."""
+    return session.execute(_summaries().order_by(BuildingRecord.id)).all()
+
+
+def _summaries() -> Select:
+    time = measurements.c[TIME]
+
+    def stored(aggregate: Any) -> Any:  # over the building's rows (index range of its key)
+        return select(aggregate).where(measurements.c.building_id == BuildingRecord.id)
+
+    return select(
+        BuildingRecord.id,
+        BuildingRecord.name,
+        BuildingRecord.timezone,
+        BuildingRecord.description,
+        BuildingRecord.created_at,
+        BuildingRecord.step_s,
+        BuildingRecord.last_measured_at.label("last_measured_time"),
+        BuildingRecord.data_revision,
+        stored(func.count()).scalar_subquery().label("rows"),
+        stored(func.min(time)).scalar_subquery().label("first_time"),
+        stored(func.max(time)).scalar_subquery().label("last_time"),
+        ParameterSetRecord.id.label("current_parameter_set_id"),
+    ).outerjoin(
+        ParameterSetRecord,
+        and_(ParameterSetRecord.building_id == BuildingRecord.id, ParameterSetRecord.is_current),
+    )
 
 
 def building_id_for_token(session: Session, token_hash: str) -> int | None:
@@ -125,18 +161,6 @@ def read_measurements(
     if end is not None:
         query = query.where(time < end)
     return session.execute(query.order_by(time)).all()
-
-
-def measurement_summary(
-    session: Session, building_id: int
-) -> tuple[int, datetime | None, datetime | None]:
-    """Row count, first and last stored time of a building."""
-    time = measurements.c[TIME]
-    query = select(func.count(), func.min(time), func.max(time)).where(
-        measurements.c.building_id == building_id
-    )
-    rows, first, last = session.execute(query).one()
-    return rows, first, last
 
 
 # --- jobs -------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ from apscheduler.triggers.cron import CronTrigger
 from .core.config import Settings
 from .core.db import Database
 from .jobs import JobRunner, queue_retraining
+from .models import CALIBRATION
 
 log = logging.getLogger(__name__)
 JOB_ID = "nightly-retrain"
@@ -38,6 +39,6 @@ def start_scheduler(settings: Settings, db: Database, runner: JobRunner) -> Back
 def retrain_due(settings: Settings, db: Database, runner: JobRunner) -> list[int]:
     job_ids = queue_retraining(db, settings, trigger="schedule")
     for job_id in job_ids:
-        runner.submit(job_id)
+        runner.submit(job_id, CALIBRATION)
     log.info("nightly retraining queued", extra={"job_ids": job_ids})
     return job_ids

@@ -4,6 +4,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
+import rcengine.signals.derived
+from rcengine.building import Building
+from rcengine.columns import VENT_LOSS, VENT_SCHEDULE, WIND_LOSS, schedule_signal_name
+from rcengine.exceptions import ModelError
+from rcengine.io.timeseries import read_timeseries
+from rcengine.signals.derived import SignalOptions, derive, derivers
 from rcengine.signals.ground import ground_temperature
 from rcengine.signals.schedules import (
     clock_zone,
@@ -69,3 +75,48 @@ def test_sky_temperature_by_hand():
     overcast = sky_temperature(np.array([0.0]), np.array([10.0]))[0]
     assert t_sky < overcast < 0.0  # clouds warm the sky, still below the air
     np.testing.assert_allclose(cloud_cover_from_index(np.array([1.0, 0.25, 0.0])), [0, 10, 10])
+
+
+def test_each_deriver_runs_once_for_all_its_signals(project_data, monkeypatch):
+    """Every derivable signal in one request: each function runs once, and every column equals
+    the one it gives when asked alone (wind_loss and vent_loss share no work, so they are not
+    computed twice)."""
+    office = project_data / "energyplus" / "office"
+    building = Building.from_json(office / "building.json")
+    frame = read_timeseries(office / "heating.csv").iloc[: 3 * 96]
+    week = np.tile(np.r_[np.zeros(8), np.ones(10), np.zeros(6)], 7).tolist()
+    options = SignalOptions(schedules={VENT_SCHEDULE: week, "gains": week})
+    names = list(derivers(building, options))
+    assert {WIND_LOSS, VENT_LOSS, schedule_signal_name("gains")} <= set(names)
+    alone = {n: derive(frame, building, [n], options)[n] for n in names}
+    calls: dict[str, int] = {}
+
+    def counted(name: str):
+        function = getattr(rcengine.signals.derived, name)
+
+        def wrapper(*args):
+            calls[name] = calls.get(name, 0) + 1
+            return function(*args)
+
+        return wrapper
+
+    for function in {f.__name__ for f in derivers(building, options).values()}:
+        monkeypatch.setattr(rcengine.signals.derived, function, counted(function))
+    together = derive(frame, building, names, options)
+    assert sorted(together.columns) == sorted(names)
+    assert calls and set(calls.values()) == {1}, calls
+    for name in names:
+        pd.testing.assert_series_equal(together[name], alone[name], check_exact=True)
+
+
+def test_signals_are_routed_by_name_not_prefix(project_data):
+    office = project_data / "energyplus" / "office"
+    building = Building.from_json(office / "building.json")
+    frame = read_timeseries(office / "heating.csv").iloc[:96]
+    # The office has no south-facing window; a solar-looking name is not a solar signal.
+    with pytest.raises(ModelError, match="solar_window_180_90"):
+        derive(frame, building, ["solar_window_180_90"], SignalOptions())
+    with pytest.raises(ModelError, match="needs a 'vent' schedule"):
+        derive(frame, building, [VENT_LOSS], SignalOptions())
+    with pytest.raises(ModelError, match="needs the column 'wind_speed'"):
+        derive(frame.drop(columns="wind_speed"), building, [WIND_LOSS], SignalOptions())

@@ -219,3 +219,102 @@ def test_invalid_params_file_is_named(workdir):
     assert result.exit_code != 0
     assert "p.json: not valid JSON" in result.output
     assert not Path("f.csv").exists()
+
+
+# --- date options: every command reads the same forms, bad ones name the option -----------------
+
+OFFICE_ZONE_DAY = ("2017-01-09", "2017-01-16")  # local dates of OFFICE_FIT in Europe/Rome
+BAD_INSTANTS = {
+    "unparseable": "9/1/2017",
+    "month 13": "2017-13-01",
+    "outside pandas' range": "2300-01-01",
+    "skipped by daylight saving": "2017-03-26T02:30",
+}
+
+
+def test_fit_reads_local_dates_in_the_buildings_zone(office, office_fit, tmp_path):
+    out = tmp_path / "params.json"
+    result = invoke(
+        "fit", office["measured"], "--building", office["building"], "--model", "basic",
+        "--start", OFFICE_ZONE_DAY[0], "--end", OFFICE_ZONE_DAY[1], "-o", out,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    fit, by_offset = json.loads(out.read_text())["fit"], office_fit["params"]["fit"]
+    for key in ("start", "end", "rows"):  # the same window as the offset instants
+        assert fit[key] == by_offset[key], key
+
+
+def test_predict_reads_a_local_date_in_the_parameter_files_zone(office, office_fit, tmp_path):
+    out = tmp_path / "forecast.csv"
+    result = invoke(
+        "predict", office["future"], "--params", office_fit["path"],
+        "--start", OFFICE_ZONE_DAY[1], "--hours", FORECAST_HOURS, "-o", out,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    first = pd.read_csv(out)[TIME].iloc[0]
+    assert pd.Timestamp(first) == pd.Timestamp(OFFICE_FORECAST_START)
+
+
+@pytest.mark.parametrize("form", [OFFICE_FIT, OFFICE_ZONE_DAY], ids=["offset", "local date"])
+def test_study_reads_instants_and_local_dates_alike(workdir, monkeypatch, form):
+    """The study's days are chosen from the instants the CLI parsed (run and writing stubbed)."""
+    import rcengine.study.report
+    import rcengine.study.run
+
+    seen = {}
+
+    def run_study(frame, building, settings, progress):
+        seen["settings"] = settings
+        return pd.DataFrame()
+
+    monkeypatch.setattr(rcengine.study.run, "run_study", run_study)
+    monkeypatch.setattr(rcengine.study.report, "write_study", lambda *args: [])
+    result = invoke(
+        "study", "data.csv", "--building", "b.json", "-o", "out", "--start", form[0],
+        "--end", form[1], "--workers", "1",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    settings = seen["settings"]
+    assert settings.start == pd.Timestamp(OFFICE_FIT[0])
+    assert settings.end == pd.Timestamp(OFFICE_FIT[1])
+
+
+def date_commands(start: str, end: str | None = None) -> dict[str, list[str]]:
+    """Each command with date options, its --start (and --end) set; outputs p.json, f.csv, out."""
+    fit = ["fit", "data.csv", "--building", "b.json", "--model", "basic", "-o", "p.json"]
+    study = ["study", "data.csv", "--building", "b.json", "-o", "out"]
+    commands = {"fit": fit, "study": study}
+    if end is None:
+        commands["predict"] = [
+            "predict", "data.csv", "--params", "params.json", "--hours", "24", "-o", "f.csv"
+        ]  # fmt: skip
+    window = ["--start", start] + ([] if end is None else ["--end", end])
+    return {name: args + window for name, args in commands.items()}
+
+
+def assert_refused(result, message: str) -> None:
+    """Exit code 2 (not a traceback's 1), one line naming the option, nothing written."""
+    assert result.exit_code == 2, result.output
+    assert isinstance(result.exception, SystemExit), result.exception
+    assert message in result.output
+    assert len(result.output.strip().splitlines()) == 1, result.output
+    assert "Traceback" not in result.output
+    for written in ("p.json", "f.csv", "out"):
+        assert not Path(written).exists(), written
+
+
+@pytest.mark.parametrize("bad", BAD_INSTANTS.values(), ids=BAD_INSTANTS.keys())
+@pytest.mark.parametrize("option", ["--start", "--end"])
+def test_bad_date_option_is_named(workdir, office_fit, bad, option):
+    Path("params.json").write_text(office_fit["path"].read_text())
+    start, end = (OFFICE_FIT[0], bad) if option == "--end" else (bad, None)
+    for command, args in date_commands(start, end).items():
+        result = invoke(*args)
+        assert_refused(result, f"{option} {bad!r} is not an ISO 8601 time")
+        assert "Europe/Rome" in result.output, command  # the zone local dates are read in
+
+
+@pytest.mark.parametrize("end", [OFFICE_FIT[0], "2017-01-08"], ids=["equal", "before"])
+def test_start_not_before_end_is_refused(workdir, end):
+    for args in date_commands(OFFICE_FIT[0], end).values():
+        assert_refused(invoke(*args), f"--start {OFFICE_FIT[0]!r} is not before --end {end!r}")

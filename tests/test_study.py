@@ -14,8 +14,9 @@ from rcengine.estimation import EstimatorSettings
 from rcengine.estimation.ga import GASettings
 from rcengine.estimation.pattern_search import GPSSettings
 from rcengine.io.timeseries import read_timeseries
+from rcengine.study.analysis import sky_class, tables
 from rcengine.study.report import write_study
-from rcengine.study.run import StudySettings, run_study, sky_class, tables
+from rcengine.study.run import StudySettings, run_study
 
 TZ = "Europe/Rome"
 # Friday 18 – Monday 21 November 2016: the Complete period predicts all four days, the Selected

@@ -16,17 +16,46 @@ import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
-from rcengine.columns import Q_HVAC, T_OUT, WIND_SPEED
+from rcengine.columns import (
+    GAINS_SCHEDULE,
+    Q_HVAC,
+    SCHED_GAINS,
+    SKY_DELTA,
+    SOLAR_OPAQUE,
+    SOLAR_WINDOW,
+    T_GROUND,
+    T_OUT,
+    UNIT,
+    VENT_LOSS,
+    VENT_SCHEDULE,
+    WIND_LOSS,
+    WIND_SPEED,
+    orientation_key,
+    solar_orientation_signal,
+)
 from rcengine.dataset import Dataset
+from rcengine.diagnose.plausibility import (
+    ABSORPTANCE,
+    EXTRA_CAPACITY_J_M2K,
+    G_VALUE,
+    SEARCH_MARGIN,
+    SKY_COUPLING,
+    U_FLOOR,
+    UNMETERED_W_M2,
+    VENTILATION_ACH,
+    WIND_ACH_PER_M_S,
+)
 from rcengine.diagnose.response import (
     explain_residual,
     node_responses,
     on_off_explainer,
     parameter_sensitivities,
 )
+from rcengine.models.bounds import R_SE, RHO_CP_AIR, envelope, internal_resistance
 from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.derived import T_REF_C
+from rcengine.signals.ground import annual_cycle, seasonal_ground_temperature
 from rcengine.signals.schedules import (
     CLOCKS,
     N_DAY_TYPES,
@@ -36,13 +65,19 @@ from rcengine.signals.schedules import (
     on_hours,
     weekly_from_day_types,
 )
-from rcengine.signals.solar import orientation_key
 
-AIR_HEAT_CAPACITY_J_M3K = 1.2 * 1005.0
 # Shares of the learnt profile's peak tried as the on/off threshold of a schedule.
 ON_SHARES = (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8)
 # Dates of a day type the training period must hold before a schedule may switch on in it.
 MIN_REPEATS = 2
+# A heater delivering at least this share of its largest output is at its capacity. [-]
+SATURATION_SHARE = 0.97
+# A heater at its largest output in more than this share of its heating rows is switched on/off
+# at one stage: its output then says nothing about capacity. [-]
+ON_OFF_SHARE = 0.5
+# Share of an hour's rows with the heater at capacity beyond which no schedule may switch on in
+# that hour (of a day type): most of its dates hold the heater's recovery. [-]
+SATURATED_HOUR_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -60,6 +95,7 @@ class Extension:
     # Values of the new parameters at which the extension does nothing: the refit's warm start
     # then contains the current model itself, so it can only improve on it.
     neutral: dict[str, float] = field(default_factory=dict)
+    # Facts an explanation quotes and ``plausibility.assess`` reads (areas, volume, temperatures).
     detail: dict = field(default_factory=dict)
 
 
@@ -133,10 +169,13 @@ def _solar_by_orientation(
     target: str,
     upper: float,
     meaning: Callable[[str, float], str],
+    factor: float = 1.0,
 ) -> Extension:
     """One gain per orientation of the building's ``kind`` surfaces ("window" or "opaque"),
-    feeding ``solar_<kind>_<orientation>`` (irradiance × area [W]) into ``target``."""
+    ``factor`` × gain × ``solar_<kind>_<orientation>`` (irradiance × area [W]) into ``target``;
+    the gain is a g-value or an absorptance, searched from 0 to ``upper``."""
     surfaces = ctx.building.windows if kind == "window" else ctx.building.walls
+    total = SOLAR_WINDOW if kind == "window" else SOLAR_OPAQUE
     net = ctx.network.copy(_name(ctx.network, effect))
     groups: dict[str, tuple[str, float]] = {}
     for s in surfaces:
@@ -147,8 +186,8 @@ def _solar_by_orientation(
     for key, (facade, area) in groups.items():
         name = f"{'g' if kind == 'window' else 'a'}_{kind}_{key}"
         net.add_parameter(Parameter(name, "-", 0.0, upper, meaning(facade, area)))
-        signal = f"solar_{kind}_{key}"
-        net.add_heat_input(signal, target, name)
+        signal = solar_orientation_signal(total, key)
+        net.add_heat_input(signal, target, name, factor=factor)
         params.append(name)
         inputs.append((signal, target))
     detail = {
@@ -167,23 +206,27 @@ def _solar_by_orientation(
 
 
 def window_solar_gains(ctx: Context) -> Extension | Skipped:
-    """Solar heat through the glazing, one gain per façade orientation, into the interior mass."""
+    """Solar heat through the glazing: g-value × the irradiance transmitted to each orientation's
+    glazing (× area, incidence-angle modifier included), absorbed by the interior mass, plus one
+    share g_air of all of it heating the air directly (sun on furniture and light linings); the
+    implied g-value of an orientation is g_k + g_air."""
     effect = "window_solar_gains"
     if not ctx.building.windows:
         return Skipped(effect, "no windows in the building JSON")
-    if _has_signal(ctx.network, "solar_window"):
+    if _has_signal(ctx.network, SOLAR_WINDOW):
         return Skipped(effect, "the model already has window solar gains")
     ext = _solar_by_orientation(
         ctx,
         effect,
         "window",
         mass_node(ctx.network),
-        0.9,
+        SEARCH_MARGIN * G_VALUE[1],
         lambda facade, area: (
-            f"share of the irradiance on the {facade} glazing ({area:g} m²) "
-            "that heats the zone (solar heat gain coefficient)"
+            f"g-value of the {facade} glazing ({area:g} m²): share of the transmitted "
+            "irradiance heating the interior mass"
         ),
     )
+    ext = _window_air_share(ctx, ext)
     if T_OUT in ctx.network.neighbours(ctx.network.output):
         return ext
     # Glazing is also a massless conductance between the air and outdoors; a model whose only
@@ -207,53 +250,120 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
     )
 
 
+def _window_air_share(ctx: Context, ext: Extension) -> Extension:
+    """``ext`` with g_air × (all the transmitted irradiance) into the air node, where the interior
+    mass is another node."""
+    air = ctx.network.output
+    if ext.detail["node"] == air:
+        return ext
+    ext.network.add_parameter(
+        Parameter(
+            "g_window_air",
+            "-",
+            0.0,
+            SEARCH_MARGIN * G_VALUE[1],
+            "part of the g-value heating the indoor air directly, every orientation",
+        )
+    )
+    ext.network.add_heat_input(SOLAR_WINDOW, air, "g_window_air")
+    return replace(
+        ext,
+        new_parameters=(*ext.new_parameters, "g_window_air"),
+        inputs=(*ext.inputs, (SOLAR_WINDOW, air)),
+        neutral={**ext.neutral, "g_window_air": 0.0},
+    )
+
+
+def exterior_film_share(ctx: Context, node: str, area: float) -> float:
+    """R_se·G_ext/A [-]: the share of a heat flux at the outer surfaces of ``area`` [m²] that
+    the current model's exterior conductance G_ext [W/K] (``node`` to t_out) carries to ``node``.
+
+    Sol-air: the sun absorbed on a surface, α·I, raises the outdoor temperature it sees by
+    α·I·R_se (R_se = 1/h_e, ISO 6946); through the resistance A/G_ext from outdoors to ``node``
+    that drives α·I·A·R_se·G_ext/A into it. Its steady share reaching the indoor air is then
+    α·R_se·U, ISO 13790 Eq. 44. At most 1: no surface passes more than it absorbs.
+    """
+    values = [
+        r.factor * (ctx.params[r.resistance] if isinstance(r.resistance, str) else r.resistance)
+        for r in ctx.network.resistors
+        if {r.a, r.b} == {T_OUT, node}
+    ]
+    conductance = sum(1.0 / v for v in values)
+    return min(1.0, R_SE * conductance / area)
+
+
 def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
-    """Solar absorbed on the opaque walls and roof by orientation (sol-air), into the envelope."""
+    """Solar absorbed on the opaque walls and roof by orientation, as sol-air: absorptance α ×
+    plane-of-array irradiance × area × the exterior film share (``exterior_film_share``, from
+    the current fit), into the envelope node."""
     effect = "opaque_solar_gains"
     if not ctx.building.walls:
         return Skipped(effect, "no opaque walls ('walls') in the building JSON")
-    if _has_signal(ctx.network, "solar_opaque"):
+    if _has_signal(ctx.network, SOLAR_OPAQUE):
         return Skipped(effect, "the model already has opaque solar gains")
-    return _solar_by_orientation(
+    node = envelope_node(ctx.network)
+    share = exterior_film_share(ctx, node, sum(w.area for w in ctx.building.walls))
+    if share == 0.0:
+        return Skipped(effect, f"no resistance from outdoors to '{node}' for sol-air to act on")
+    ext = _solar_by_orientation(
         ctx,
         effect,
         "opaque",
-        envelope_node(ctx.network),
-        0.3,
-        lambda facade, area: (
-            f"share of the irradiance on the {facade} opaque surfaces "
-            f"({area:g} m²) reaching the envelope node (absorptance × inward fraction)"
-        ),
+        node,
+        SEARCH_MARGIN * ABSORPTANCE[1],
+        lambda facade, area: f"solar absorptance of the {facade} opaque surfaces ({area:g} m²)",
+        share,
     )
+    return replace(ext, detail={**ext.detail, "film_share": share})
 
 
-def wind_infiltration(ctx: Context) -> Extension | Skipped:
-    """Air leakage growing with wind speed: loss = k · wind · (T_in − t_out)."""
-    effect = "wind_infiltration"
-    if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
-        return Skipped(effect, "no wind_speed column in the data")
+def _with_gain(
+    ctx: Context,
+    effect: str,
+    gain: Parameter,
+    heat: tuple[str, str],
+    detail: dict,
+    factor: float = 1.0,
+) -> Extension:
+    """The current network plus one heat input, ``factor`` × ``gain`` × signal into node
+    (``heat`` = (signal, node)) [W]. The gain's lower bound, zero, is where the extension does
+    nothing."""
+    signal, node = heat
     net = ctx.network.copy(_name(ctx.network, effect))
-    upper = AIR_HEAT_CAPACITY_J_M3K * ctx.building.volume / 3600.0  # 1 air change/h per m/s
-    net.add_parameter(
-        Parameter(
-            "k_wind",
-            "W/(K·m/s)",
-            0.0,
-            upper,
-            f"infiltration conductance per m/s of wind: loss = k·wind·({T_REF_C:g} °C − t_out)",
-        )
-    )
-    net.add_heat_input("wind_loss", net.output, "k_wind")
-    detail = {"volume_m3": ctx.building.volume}
+    net.add_parameter(gain)
+    net.add_heat_input(signal, node, gain.name, factor=factor)
     return Extension(
         effect,
         net,
         ctx.signals,
-        ("k_wind",),
-        (("wind_loss", net.output),),
-        neutral={"k_wind": 0.0},
+        (gain.name,),
+        (heat,),
+        neutral={gain.name: gain.lower},
         detail=detail,
     )
+
+
+def _per_air_change(ctx: Context) -> float:
+    """Conductance of one air change per hour through the zone, ρ·c_p·V/3600. [W/K per 1/h]"""
+    return RHO_CP_AIR * ctx.building.volume / 3600.0
+
+
+def wind_infiltration(ctx: Context) -> Extension | Skipped:
+    """Air leakage growing with wind speed, in air changes per hour per m/s through the volume:
+    loss = n_wind · ρc_pV/3600 · wind · (T_REF − t_out)."""
+    effect = "wind_infiltration"
+    if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
+        return Skipped(effect, "no wind_speed column in the data")
+    ach_wind = Parameter(
+        "ach_wind",
+        "1/h per m/s",
+        0.0,
+        SEARCH_MARGIN * WIND_ACH_PER_M_S[1],
+        f"air changes per hour per m/s of wind: loss = n·ρc_pV/3600·wind·({T_REF_C:g} °C − t_out)",
+    )
+    heat = (WIND_LOSS, ctx.network.output)
+    detail = {"volume_m3": ctx.building.volume}
+    return _with_gain(ctx, effect, ach_wind, heat, detail, _per_air_change(ctx))
 
 
 @dataclass(frozen=True)
@@ -276,8 +386,30 @@ def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> LearntSch
     Learnt on both clocks a building may keep (civil time or standard time all year) unless the
     model already plays a schedule on one; the clock whose schedule explains more is kept.
     """
-    learnt = [_schedule_on_clock(ctx, node, per_unit, clock) for clock in _clocks(ctx)]
+    saturated = heater_saturated(ctx.train)
+    learnt = [
+        _schedule_on_clock(ctx, saturated, node, per_unit, clock) for clock in _clocks(ctx)
+    ]
     return max(learnt, key=lambda s: s.explained)
+
+
+def heater_saturated(frame: pd.DataFrame) -> np.ndarray:
+    """Rows where ``q_hvac`` sits at the heater's capacity: within ``SATURATION_SHARE`` of its
+    largest output, unless that is how the heater always runs (``ON_OFF_SHARE``).
+
+    A heater at capacity leaves the room under its setpoint in a pattern that repeats every cold
+    morning; its recovery is metered physics, not a schedule, and learning a schedule from those
+    rows would name it a missing gain or loss.
+    """
+    if Q_HVAC not in frame.columns:
+        return np.zeros(len(frame), dtype=bool)
+    q = np.nan_to_num(frame[Q_HVAC].to_numpy(dtype=float))
+    peak = q.max(initial=0.0)
+    at_peak = q >= SATURATION_SHARE * peak
+    heating = q > (1.0 - SATURATION_SHARE) * peak
+    if peak <= 0.0 or at_peak.sum() > ON_OFF_SHARE * heating.sum():
+        return np.zeros(len(frame), dtype=bool)
+    return at_peak
 
 
 def _clocks(ctx: Context) -> tuple[str, ...]:
@@ -290,8 +422,12 @@ def _clocks(ctx: Context) -> tuple[str, ...]:
     return ("local",) if np.array_equal(day_type_hour(ctx.data.times, tz), standard) else CLOCKS
 
 
-def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str) -> LearntSchedule:
-    """The schedule on one clock, in three steps.
+def _schedule_on_clock(
+    ctx: Context, saturated: np.ndarray, node: str, per_unit: np.ndarray, clock: str
+) -> LearntSchedule:
+    """The schedule on one clock, in three steps, learnt from the training residual outside the
+    rows where the heater is ``saturated`` (``heater_saturated``) and never switching on in an
+    hour of a day type where the heater is at capacity on most dates.
 
     1. θ_h ≥ 0 for every hour of the three day types of building schedules (weekdays, Saturday,
        Sunday; a day type seen on fewer than two dates stays off) is the value that, passed
@@ -315,20 +451,24 @@ def _schedule_on_clock(ctx: Context, node: str, per_unit: np.ndarray, clock: str
     repeated = np.repeat(
         [dates[hour // 24 == k].nunique() >= MIN_REPEATS for k in range(N_DAY_TYPES)], 24
     )
-    heat[:, ~repeated] = 0.0
+    # A heater at capacity leaves the same deficit every cold morning; an hour that holds that
+    # recovery on most of its dates cannot be told apart from it.
+    rows = np.bincount(hour, minlength=N_DAY_TYPES * 24)
+    at_capacity = np.bincount(hour, weights=saturated, minlength=N_DAY_TYPES * 24)
+    allowed = repeated & (at_capacity < SATURATED_HOUR_SHARE * rows)
+    heat[:, ~allowed] = 0.0
+    residual = np.where(saturated, np.nan, ctx.residual)
     responses = node_responses(ctx.network, ctx.params, data, node, heat)
     theta = np.zeros(N_DAY_TYPES * 24)
-    if repeated.any():
-        theta[repeated] = explain_residual(
-            ctx.residual, responses[:, repeated], ctx.sensitivities
-        )[0]
+    if allowed.any():
+        theta[allowed] = explain_residual(residual, responses[:, allowed], ctx.sensitivities)[0]
     # Neighbouring hours share a schedule; the mean over three damps least squares' spiky
     # solutions, which would otherwise set the peak (each day type wraps around midnight).
     days = theta.reshape(N_DAY_TYPES, 24)
     profile = ((np.roll(days, 1, axis=1) + days + np.roll(days, -1, axis=1)) / 3.0).ravel()
-    explained = on_off_explainer(ctx.residual, responses, ctx.sensitivities)
-    start = max((on_hours(profile, share) for share in ON_SHARES), key=explained)
-    best = _move_edges(start, explained)
+    explained = on_off_explainer(residual, responses, ctx.sensitivities)
+    start = max((on_hours(profile, share) * allowed for share in ON_SHARES), key=explained)
+    best = _move_edges(start, explained) * allowed
     return LearntSchedule(weekly_from_day_types(best), clock, explained(best))
 
 
@@ -352,149 +492,159 @@ def _move_edges(
         schedule[h], value = 1.0 - schedule[h], best
 
 
+def _on_schedule(ext: Extension, name: str, learnt: LearntSchedule) -> Extension:
+    """``ext`` with its input played on the weekly schedule ``name``, learnt from the residual
+    (and learnt again after each refit)."""
+    signals = replace(
+        ext.signals,
+        schedules={**ext.signals.schedules, name: learnt.schedule.tolist()},
+        schedule_clock=learnt.clock,
+    )
+    detail = {"schedule": learnt.words, "clock": learnt.clock, **ext.detail}
+    return replace(ext, signals=signals, learnt=True, detail=detail)
+
+
 def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     """Outdoor-air ventilation in the hours the residuals show an extra loss that grows with
     the indoor–outdoor difference: loss = h · schedule · (T_in − t_out)."""
     effect = "ventilation_schedule"
-    if "vent_loss" in ctx.network.signals:
+    if VENT_LOSS in ctx.network.signals:
         return Skipped(effect, "the model already has a ventilation schedule")
     outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - T_REF_C
     learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess)
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
-    signals = replace(
-        ctx.signals,
-        schedules={**ctx.signals.schedules, "vent": learnt.schedule.tolist()},
-        schedule_clock=learnt.clock,
+    ach_vent = Parameter(
+        "ach_vent",
+        "1/h",
+        0.0,
+        SEARCH_MARGIN * VENTILATION_ACH[1],
+        f"air changes per hour in the scheduled hours (loss = n·ρc_pV/3600·({T_REF_C:g} °C − "
+        "t_out))",
     )
-    net = ctx.network.copy(_name(ctx.network, effect))
-    upper = AIR_HEAT_CAPACITY_J_M3K * ctx.building.volume * 10.0 / 3600.0  # 10 air changes/h
-    net.add_parameter(
-        Parameter(
-            "h_vent",
-            "W/K",
-            0.0,
-            upper,
-            f"ventilation conductance in the scheduled hours (loss = h · ({T_REF_C:g} °C − t_out))",
-        )
-    )
-    net.add_heat_input("vent_loss", net.output, "h_vent")
-    detail = {"schedule": learnt.words, "clock": learnt.clock, "volume_m3": ctx.building.volume}
-    return Extension(
-        effect,
-        net,
-        signals,
-        ("h_vent",),
-        (("vent_loss", net.output),),
-        learnt=True,
-        neutral={"h_vent": 0.0},
-        detail=detail,
-    )
+    heat = (VENT_LOSS, ctx.network.output)
+    detail = {"volume_m3": ctx.building.volume}
+    ext = _with_gain(ctx, effect, ach_vent, heat, detail, _per_air_change(ctx))
+    return _on_schedule(ext, VENT_SCHEDULE, learnt)
 
 
 def unmetered_gains(ctx: Context) -> Extension | Skipped:
     """Internal gains missing from the data, on the weekly schedule the residuals reveal."""
     effect = "unmetered_gains"
-    if "sched_gains" in ctx.network.signals:
+    if SCHED_GAINS in ctx.network.signals:
         return Skipped(effect, "the model already has an unmetered-gain schedule")
     learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)))
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of missing heat")
-    signals = replace(
-        ctx.signals,
-        schedules={**ctx.signals.schedules, "gains": learnt.schedule.tolist()},
-        schedule_clock=learnt.clock,
+    floor = ctx.building.floor_area
+    q_unmetered = Parameter(
+        "q_unmetered",
+        "W/m²",
+        0.0,
+        SEARCH_MARGIN * UNMETERED_W_M2[1],
+        "unmetered internal heat (equipment, people) in the scheduled hours, per m² of floor",
     )
-    net = ctx.network.copy(_name(ctx.network, effect))
-    net.add_parameter(
-        Parameter(
-            "q_unmetered",
-            "W",
-            0.0,
-            60.0 * ctx.building.floor_area,
-            "unmetered internal heat (equipment, people) in the scheduled hours",
-        )
-    )
-    net.add_heat_input("sched_gains", net.output, "q_unmetered")
-    detail = {
-        "schedule": learnt.words,
-        "clock": learnt.clock,
-        "floor_area_m2": ctx.building.floor_area,
-    }
-    return Extension(
-        effect,
-        net,
-        signals,
-        ("q_unmetered",),
-        (("sched_gains", net.output),),
-        learnt=True,
-        neutral={"q_unmetered": 0.0},
-        detail=detail,
-    )
+    heat = (SCHED_GAINS, ctx.network.output)
+    ext = _with_gain(ctx, effect, q_unmetered, heat, {"floor_area_m2": floor}, floor)
+    return _on_schedule(ext, GAINS_SCHEDULE, learnt)
 
 
 def ground_coupling(ctx: Context) -> Extension | Skipped:
-    """Heat exchange through the floor with the slowly varying ground temperature."""
+    """Heat exchange through the floor with the soil under it, into the interior mass.
+
+    q = U_floor·A_floor·(T_base(t) + ΔT − T_mass), with U_floor = 1/r_floor and T_base the
+    outdoor annual cycle damped and lagged into the soil (``signals.ground``, signal t_ground);
+    the soil's warming by the building, ΔT, is fitted as the constant heat q_ground = U_floor·ΔT
+    per m² of floor on the ``unit`` signal, so the fitted ground temperature is T_base + q·r.
+    """
     effect = "ground_coupling"
-    if "t_ground" in ctx.network.signals:
+    if T_GROUND in ctx.network.signals:
         return Skipped(effect, "the model already has ground coupling")
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
     target = mass_node(net)
     net.add_parameter(
         Parameter(
-            "r_ground",
+            "r_floor",
             "m²K/W",
-            0.05,
-            50.0,
-            "resistance between the floor/interior mass and the ground, per floor area",
+            1.0 / (SEARCH_MARGIN * U_FLOOR[1]),
+            SEARCH_MARGIN / U_FLOOR[0],
+            "resistance between the floor/interior mass and the soil, per floor area (1/U)",
         )
     )
-    net.add_resistor("t_ground", target, "r_ground", factor=1.0 / floor)
-    detail = {"node": target, "floor_area_m2": floor}
+    net.add_parameter(
+        Parameter(
+            "q_ground",
+            "W/m²",
+            -20.0,
+            60.0,
+            "constant heat from the soil's warming by the building, U·ΔT, per floor area",
+        )
+    )
+    net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / floor)
+    net.add_heat_input(UNIT, target, "q_ground", factor=floor)
     return Extension(
         effect,
         net,
         ctx.signals,
-        ("r_ground",),
-        (("t_ground", target),),
-        neutral={"r_ground": 50.0},
-        detail=detail,
+        ("r_floor", "q_ground"),
+        ((T_GROUND, target), (UNIT, target)),
+        neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
+        detail={"node": target, "floor_area_m2": floor, **_ground_temperatures(ctx)},
     )
+
+
+def _ground_temperatures(ctx: Context) -> dict[str, float]:
+    """What the fitted ground temperature is judged against, over the training period [°C]: the
+    mean of T_base, the outdoor annual mean and the mean indoor temperature."""
+    times, t_out = ctx.data.times, ctx.train[T_OUT].to_numpy(dtype=float)
+    latitude = ctx.building.location.latitude
+    base = seasonal_ground_temperature(times, t_out, latitude)
+    return {
+        "ground_base_c": float(np.mean(base)),
+        "outdoor_mean_c": float(annual_cycle(times, t_out, latitude).mean),
+        "indoor_mean_c": float(np.nanmean(ctx.data.measured)),
+    }
+
+
+def sky_view_area(building: Building) -> float:
+    """Σ A·(1 + cos β)/2 over the opaque surfaces (tilt β): the sky view factor weights a roof
+    by 1 and a wall by ½. Without ``walls``, a roof as large as the floor and ``wall_area``. [m²]"""
+    if not building.walls:
+        return building.floor_area + 0.5 * building.wall_area
+    return sum(s.area * (1.0 + np.cos(np.radians(s.tilt))) / 2.0 for s in building.walls)
 
 
 def sky_radiation(ctx: Context) -> Extension | Skipped:
-    """Long-wave loss of the envelope to the (cold, clear, night) sky: q = h · (T_sky − t_out)."""
+    """Long-wave loss of the envelope to the (cold, clear, night) sky, as sol-air in the
+    long-wave: q = h_sky·F·A·(T_sky − t_out) at the outer surfaces (h_sky ≈ ε·4σT³ per m² of
+    sky-viewing area, ``sky_view_area``) reaching the envelope node by the exterior film share
+    (``exterior_film_share``)."""
     effect = "sky_radiation"
-    if "sky_delta" in ctx.network.signals:
+    if SKY_DELTA in ctx.network.signals:
         return Skipped(effect, "the model already has sky radiation")
-    net = ctx.network.copy(_name(ctx.network, effect))
-    target = envelope_node(net)
-    area = ctx.building.floor_area + ctx.building.wall_area  # roof + walls seeing the sky
-    net.add_parameter(
-        Parameter(
-            "h_sky",
-            "W/K",
-            0.0,
-            3.0 * area,
-            "long-wave coupling of the envelope to the sky (≈ ε·h_r·F_sky·A)",
-        )
+    target = envelope_node(ctx.network)
+    building = ctx.building
+    opaque = sum(s.area for s in building.walls) or building.wall_area + building.floor_area
+    view = sky_view_area(building)
+    h_sky = Parameter(
+        "h_sky",
+        "W/(m²K)",
+        0.0,
+        SEARCH_MARGIN * SKY_COUPLING[1],
+        f"long-wave coupling ε·h_r of the envelope to the sky, per m² of roof + ½ wall ({view:g} "
+        "m²)",
     )
-    net.add_heat_input("sky_delta", target, "h_sky")
-    detail = {"node": target}
-    return Extension(
-        effect,
-        net,
-        ctx.signals,
-        ("h_sky",),
-        (("sky_delta", target),),
-        neutral={"h_sky": 0.0},
-        detail=detail,
-    )
+    share = exterior_film_share(ctx, target, opaque)
+    if share == 0.0:
+        return Skipped(effect, f"no resistance from outdoors to '{target}' for the sky to act on")
+    detail = {"node": target, "sky_view_area_m2": view, "film_share": share}
+    return _with_gain(ctx, effect, h_sky, (SKY_DELTA, target), detail, share * view)
 
 
 def thermal_mass(ctx: Context) -> Extension | Skipped:
-    """A heat-storage state the model lacks, coupled to the indoor air."""
+    """A heat-storage state the model lacks, coupled to the indoor air; capacity and coupling
+    resistance per m² of floor."""
     effect = "thermal_mass"
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
@@ -504,7 +654,7 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
             "c_mass_extra",
             "J/(K·m²)",
             1e3,
-            1e6,
+            SEARCH_MARGIN * EXTRA_CAPACITY_J_M2K[1],
             "heat capacity of the added storage, per floor area",
         )
     )
@@ -514,7 +664,7 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
             "m²K/W",
             1e-3,
             5.0,
-            "resistance between the indoor air and the added storage",
+            "resistance between the indoor air and the added storage, per floor area",
         )
     )
     net.add_capacitor(node, "c_mass_extra", factor=floor)
@@ -526,7 +676,11 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
         ("c_mass_extra", "r_mass_extra"),
         structural=True,
         neutral={"c_mass_extra": 1e3, "r_mass_extra": 5.0},
-        detail={"node": node},
+        detail={
+            "node": node,
+            "floor_area_m2": floor,
+            "coupling_range_m2k_w": internal_resistance(envelope(ctx.building)),
+        },
     )
 
 
@@ -548,7 +702,7 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
             "c_emitter",
             "J/(K·m²)",
             1e2,
-            5e5,
+            5e5,  # past any emitter's (plausibility.EMITTER_CAPACITY_J_M2K)
             "heat capacity of the emitter (water, metal, screed), per floor area",
         )
     )
@@ -571,7 +725,7 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
         ("c_emitter", "r_emitter"),
         structural=True,
         neutral={"c_emitter": 1e2, "r_emitter": 1e-3},
-        detail={"node": "emitter"},
+        detail={"node": "emitter", "floor_area_m2": floor},
     )
 
 

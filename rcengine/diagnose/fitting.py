@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,6 +11,7 @@ import pandas as pd
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
+from rcengine.diagnose.folds import Fold
 from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
 from rcengine.exceptions import ConvergenceWarning
@@ -38,6 +40,21 @@ def split_data(
     """Derive the model's signals on the whole record (slow signals need the history), then cut."""
     data = prepare(frame, building, network.compile().input_names, options)
     return Split(data.between(None, boundary), data.between(boundary, None))
+
+
+def fold_splits(
+    frame: pd.DataFrame,
+    building: Building,
+    network: RCNetwork,
+    options: SignalOptions,
+    folds: Sequence[Fold],
+) -> list[Split]:
+    """The record prepared once for the network and cut at every fold's boundaries."""
+    data = prepare(frame, building, network.compile().input_names, options)
+    return [
+        Split(data.between(f.train_start, f.test_start), data.between(f.test_start, f.test_end))
+        for f in folds
+    ]
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from rcengine.diagnose.fitting import Fit
 from rcengine.diagnose.locate import DAYS, hour_weekday
 from rcengine.diagnose.report import Finding, Report
 
@@ -23,6 +24,7 @@ table{border-collapse:collapse}td,th{padding:.3em .7em;border-bottom:1px solid #
 .ok{color:#0a6d2c;font-weight:600}.no{color:#8a1c1c}.box{background:#f5f7fa;padding:1em;border-radius:6px}
 img{max-width:100%}
 """
+_COLOURS = {"before": "#d62728", "after": "#1f77b4"}
 
 
 def _png(fig: plt.Figure | None) -> str:
@@ -35,26 +37,28 @@ def _png(fig: plt.Figure | None) -> str:
     return f'<img alt="figure" src="data:image/png;base64,{data}">'
 
 
+def _before_after(report: Report) -> list[tuple[str, str, Fit]]:
+    """("before", model, fit) of the baseline and, when the diagnosis extended it, ("after",
+    model, fit) of the final model."""
+    fits = [("before", report.model, report.baseline)]
+    if report.final is not report.baseline:
+        fits.append(("after", report.final.network.name, report.final))
+    return fits
+
+
 def timeseries_figure(report: Report, days: int = 14) -> plt.Figure:
     test = report.baseline.split.test
     local = test.times.tz_convert(report.building.location.timezone)
     n = min(len(test), int(days * 86400 / test.step_s))
     fig, ax = plt.subplots(figsize=(11, 3.6))
     ax.plot(local[:n], test.measured[:n], color="k", lw=1.2, label="measured")
-    ax.plot(
-        local[:n],
-        report.baseline.simulated_test[:n],
-        color="#d62728",
-        lw=1,
-        label=f"{report.model} (test RMSE {report.baseline.rmse_test:.2f} K)",
-    )
-    if report.final is not report.baseline:
+    for when, name, fit in _before_after(report):
         ax.plot(
             local[:n],
-            report.final.simulated_test[:n],
-            color="#1f77b4",
+            fit.simulated_test[:n],
+            color=_COLOURS[when],
             lw=1,
-            label=f"{report.final.network.name} (test RMSE {report.final.rmse_test:.2f} K)",
+            label=f"{name} (test RMSE {fit.rmse_test:.2f} K)",
         )
     ax.set_ylabel("indoor temperature [°C]")
     ax.set_title(f"Test period, first {days} days: measured vs predicted before and after")
@@ -65,9 +69,7 @@ def timeseries_figure(report: Report, days: int = 14) -> plt.Figure:
 
 def heatmaps_figure(report: Report) -> plt.Figure:
     tz = report.building.location.timezone
-    grids = [("before: " + report.model, report.baseline)]
-    if report.final is not report.baseline:
-        grids.append(("after: " + report.final.network.name, report.final))
+    grids = [(f"{when}: {name}", fit) for when, name, fit in _before_after(report)]
     fig, axes = plt.subplots(1, len(grids), figsize=(5.5 * len(grids), 3.2), squeeze=False)
     values = [hour_weekday(f.residual_test, f.split.test.times, tz) for _, f in grids]
     limit = max(0.1, float(np.nanmax([np.nanmax(np.abs(v)) for v in values])))
@@ -125,9 +127,10 @@ def evidence_figure(report: Report, finding: Finding) -> plt.Figure | None:
 
 
 def _residual_before(report: Report, finding: Finding) -> np.ndarray:
-    # The residual the candidate was screened against: the model of the round it was judged in.
+    # The residual the candidate was screened against: the model of the round it was judged in,
+    # the base model extended by every finding accepted in an earlier round (a repair is round 0).
     fits = [report.baseline] + [f.fit for f in report.accepted]
-    return fits[min(finding.round - 1, len(fits) - 1)].residual_train
+    return fits[sum(f.round < finding.round for f in report.accepted)].residual_train
 
 
 def save_figures(report: Report, folder: Path, stem: str) -> list[Path]:
@@ -150,6 +153,44 @@ def save_figures(report: Report, folder: Path, stem: str) -> list[Path]:
     return paths
 
 
+def _health_box(d: dict) -> str:
+    """The base model's health: its verdict, the reasons and notes."""
+    health = d["baseline"].get("health")
+    if health is None:
+        return ""
+    esc = html.escape
+    items = "".join(f"<li>{esc(r)}</li>" for r in health["reasons"]) + "".join(
+        f"<li><i>note:</i> {esc(n)}</li>" for n in health["notes"]
+    )
+    cls = "ok" if health["verdict"] == "healthy" else "no"
+    return f"<p>Base model: <span class={cls}>{esc(health['verdict'])}</span></p><ul>{items}</ul>"
+
+
+def _folds_table(finding: dict) -> str:
+    """Per-fold test RMSE before and after a finding's extension, and the pooled test."""
+    folds = finding["folds"]
+    if not folds:
+        return ""
+    rows = "".join(
+        f"<tr><td>{html.escape(f.get('test', str(k + 1)))}</td>"
+        f"<td>{f['rmse_test_before']:.3f}</td><td>{f['rmse_test_after']:.3f}</td>"
+        + (
+            "<td class=ok>helped</td>"
+            if f["rmse_test_after"] < f["rmse_test_before"]
+            else "<td class=no>did not</td>"
+        )
+        + "</tr>"
+        for k, f in enumerate(folds["folds"])
+    )
+    return (
+        f"<h4>{html.escape(finding['effect'])} across rolling folds: helps in {folds['helped']} "
+        f"of {len(folds['folds'])} (confidence {folds['confidence']:.0%})</h4>"
+        "<table><tr><th>test period</th><th>RMSE before [K]</th><th>after [K]</th><th></th></tr>"
+        f"{rows}<tr><td><b>pooled</b></td><td>{folds['pooled_rmse_test_before']:.3f}</td>"
+        f"<td>{folds['pooled_rmse_test_after']:.3f}</td><td></td></tr></table>"
+    )
+
+
 def render(report: Report) -> str:
     """The report as a standalone HTML page."""
     d = report.to_dict()
@@ -169,11 +210,12 @@ def render(report: Report) -> str:
         f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_png(evidence_figure(report, f))}"
         for f in report.accepted
     )
+    folds = "".join(_folds_table(f) for f in d["findings"])
     white = d["whiteness"]
     return f"""<!doctype html><html><head><meta charset="utf-8">
 <title>Mismatch diagnosis — {esc(report.building.name)}</title><style>{_STYLE}</style></head><body>
 <h1>Mismatch diagnosis — {esc(report.building.name)}</h1>
-<div class="box"><p><b>{esc(d["verdict"])}</b></p>
+<div class="box"><p><b>{esc(d["verdict"])}</b></p>{_health_box(d)}
 <p>Baseline <b>{esc(report.model)}</b>: train RMSE {d["baseline"]["rmse_train"]:.3f} K,
 test RMSE {d["baseline"]["rmse_test"]:.3f} K. Final <b>{esc(d["final"]["model"])}</b>:
 train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
@@ -186,6 +228,7 @@ test until {esc(d["periods"]["test"][1][:10])}.</p>
 <h2>Findings</h2><table><tr><th>effect</th><th>verdict</th><th>screening</th>
 <th>test RMSE before [K]</th><th>after [K]</th><th>ΔBIC</th><th>reason</th></tr>{rows}</table>
 <h2>Evidence for accepted findings</h2>{evidence or "<p>None accepted.</p>"}
+<h2>Evidence across rolling folds</h2>{folds or "<p>Judged on the single split alone.</p>"}
 <h2>Residual whiteness (Ljung–Box, hourly one-step-ahead errors, 24 lags)</h2>
 <p>Before: Q = {white["baseline"]["q"]:.0f},
 lag-1 h autocorrelation {white["baseline"]["rho_1h"]:.2f};

@@ -4,15 +4,21 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
+from rcengine.columns import SOLAR_OPAQUE, SOLAR_WINDOW, solar_orientation_signal
 from rcengine.diagnose.candidates import Extension
 from rcengine.diagnose.fitting import Fit
+from rcengine.diagnose.folds import Fold, FoldEvidence, judge_folds
+from rcengine.diagnose.health import FitQuality, Health
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.screen import Screen
+from rcengine.diagnose.settings import DiagnoseSettings
+from rcengine.io.jsonable import jsonable
 
 # What each effect means, in the words of the report.
 MISSING = {
@@ -31,7 +37,14 @@ MISSING = {
 
 @dataclass
 class Finding:
-    """One candidate's verdict. ``rmse_test_after`` is None when it was only screened."""
+    """One candidate's verdict. ``rmse_test_after`` is None when it was only screened.
+
+    magnitudes: the fitted effect in physical units (plausibility check); folds: its evidence
+    across the rolling folds (``FoldEvidence.to_dict``), ``evidence`` the residuals behind it;
+    runner_up / lost_to: {"effect", "reason"} of the head-to-head between candidates that both
+    passed; baseline_repair: taken to make an inadequate base model healthy, not judged as a
+    candidate.
+    """
 
     effect: str
     accepted: bool
@@ -49,8 +62,14 @@ class Finding:
     reason: str = ""
     explanation: str = ""
     detail: dict = field(default_factory=dict)
+    magnitudes: dict[str, dict] = field(default_factory=dict)
+    folds: dict | None = None
+    runner_up: dict[str, str] | None = None
+    lost_to: dict[str, str] | None = None
+    baseline_repair: bool = False
     screen: Screen | None = None
     fit: Fit | None = None
+    evidence: FoldEvidence | None = None
 
     @property
     def improvement_k(self) -> float:
@@ -75,6 +94,11 @@ class Finding:
             "parameters_at_bounds": self.at_bounds,
             "reason": self.reason,
             "detail": self.detail,
+            "magnitudes": self.magnitudes,
+            "folds": self.folds,
+            "runner_up": self.runner_up,
+            "lost_to": self.lost_to,
+            "baseline_repair": self.baseline_repair,
         }
 
 
@@ -84,7 +108,7 @@ def judge(
     fit: Fit,
     screened: Screen,
     round_no: int,
-    settings,
+    settings: DiagnoseSettings,
     building: Building,
 ) -> Finding:
     """Accept an extension only for a meaningful test improvement that the BIC confirms."""
@@ -128,14 +152,12 @@ def judge(
         signal: float(np.nanmax(np.abs(fit.split.train.frame[signal].to_numpy(dtype=float))))
         for signal, _ in ext.inputs
     }
-    return Finding(
-        effect=ext.effect,
+    return _finding(
+        ext,
+        current,
+        screened,
+        round_no,
         accepted=accepted,
-        round=round_no,
-        screen_explained=screened.explained,
-        screen_method=screened.method,
-        rmse_test_before=before,
-        rmse_train_before=current.rmse_train,
         rmse_test_after=after,
         rmse_train_after=fit.rmse_train,
         delta_bic=delta_bic,
@@ -144,24 +166,68 @@ def judge(
         at_bounds=bounds,
         reason=reason,
         detail=detail,
-        screen=screened,
         fit=fit,
     )
 
 
+def confirm_on_folds(
+    finding: Finding,
+    evidence: FoldEvidence,
+    folds: list[Fold],
+    settings: DiagnoseSettings,
+    timezone: str,
+) -> None:
+    """Keep a finding that passed the single split accepted only if it also helps in most folds
+    and on their pooled test; the fold evidence goes into the finding either way."""
+    ok, text = judge_folds(evidence, settings.fold_rule)
+    finding.evidence = evidence
+    finding.folds = evidence.to_dict(folds, timezone)
+    single = finding.reason.removeprefix("accepted: ")
+    finding.accepted = ok
+    finding.reason = (
+        f"accepted: {single}; across folds: {text}"
+        if ok
+        else f"rejected across folds: {text} (single split: {single})"
+    )
+
+
+def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: list[str]) -> None:
+    """Record the fitted magnitudes in physical units; an implausible one rejects the finding."""
+    finding.magnitudes = magnitudes
+    if not problems:
+        return
+    text = "implausible: " + "; ".join(problems)
+    finding.reason = f"rejected as {text}" if finding.accepted else f"{finding.reason}; {text}"
+    finding.accepted = False
+
+
 def screened_only(ext: Extension, current: Fit, screened: Screen, round_no: int) -> Finding:
+    return _finding(
+        ext,
+        current,
+        screened,
+        round_no,
+        accepted=False,
+        parameters=screened.coefficients,
+        reason="not refitted: weaker screening evidence than the refitted candidates",
+        detail=dict(ext.detail),
+    )
+
+
+def _finding(
+    ext: Extension, current: Fit, screened: Screen, round_no: int, **verdict: Any
+) -> Finding:
+    """A finding on ``ext`` in round ``round_no``: its screening and the current model's errors
+    [K], with the ``verdict`` fields (accepted, refit results, reason, detail)."""
     return Finding(
         effect=ext.effect,
-        accepted=False,
         round=round_no,
         screen_explained=screened.explained,
         screen_method=screened.method,
         rmse_test_before=current.rmse_test,
         rmse_train_before=current.rmse_train,
-        parameters=screened.coefficients,
-        reason="not refitted: weaker screening evidence than the refitted candidates",
-        detail=dict(ext.detail),
         screen=screened,
+        **verdict,
     )
 
 
@@ -188,17 +254,63 @@ def explain(finding: Finding, pattern: str) -> str:
     removed = 1.0 - (finding.rmse_train_after / finding.rmse_train_before) ** 2
     correction = finding.detail.get("correction", "")
     if finding.accepted:
+        repair = (
+            "The base model cannot represent this building without it. "
+            if finding.baseline_repair
+            else ""
+        )
         return (
-            f"The model left out {what}. Where and when: {pattern}; {correction}{facts}. "
+            f"{repair}The model left out {what}. Where and when: {pattern}; {correction}{facts}. "
             f"Adding it ({_values(finding)}) removes {max(removed, 0.0):.0%} of the training "
             f"error and cuts the test RMSE from {finding.rmse_test_before:.2f} to "
-            f"{finding.rmse_test_after:.2f} °C."
+            f"{finding.rmse_test_after:.2f} K{_across(finding)}."
         )
     return (
         f"Not confirmed — {what}{facts}: adding it ({_values(finding)}) changes the test RMSE "
-        f"from {finding.rmse_test_before:.2f} to {finding.rmse_test_after:.2f} °C "
+        f"from {finding.rmse_test_before:.2f} to {finding.rmse_test_after:.2f} K "
         f"({finding.reason})."
     )
+
+
+def _across(finding: Finding) -> str:
+    if finding.folds is None:
+        return ""
+    n = len(finding.folds["folds"])
+    return (
+        f"; across {n} rolling folds it helps in {finding.folds['helped']} "
+        f"(pooled test RMSE {finding.folds['pooled_rmse_test_before']:.2f} → "
+        f"{finding.folds['pooled_rmse_test_after']:.2f} K)"
+    )
+
+
+def verdict(findings: list[Finding], health: Health | None) -> str:
+    """"nothing missing", "missing: <effect>[, <effect>]", or, when the base model cannot
+    represent the building, "base model inadequate: <reasons>" and what was found against the
+    healthy model reached by a repair step, or against the inadequate one when none was."""
+    missing = [f.effect for f in findings if f.accepted and not f.baseline_repair]
+    found = "missing: " + ", ".join(missing) if missing else "nothing missing"
+    if health is None or health.healthy:
+        return found
+    repairs = [f.effect for f in findings if f.accepted and f.baseline_repair]
+    against = (
+        f"healthy with {', '.join(repairs)}, then {found}"
+        if repairs
+        else f"judged against it anyway: {found}"
+    )
+    return f"base model inadequate: {'; '.join(health.reasons)} — {against}"
+
+
+def health_dict(health: Health, quality: FitQuality) -> dict:
+    """The base model's health for the report: verdict, reasons, notes, parameters on bounds,
+    and its test RMSE against the naive forecasts' [K]."""
+    return {
+        "verdict": health.verdict,
+        "reasons": list(health.reasons),
+        "notes": list(health.notes),
+        "parameters_on_bounds": list(health.on_bounds),
+        "rmse_test": quality.rmse,
+        "naive_rmse_test": quality.naive,
+    }
 
 
 def _facts(finding: Finding) -> str:
@@ -221,12 +333,16 @@ def _facts(finding: Finding) -> str:
 
 
 def _signal_of(finding: Finding, orientation: str) -> str:
-    kind = "window" if finding.effect == "window_solar_gains" else "opaque"
-    return f"solar_{kind}_{orientation}"
+    total = SOLAR_WINDOW if finding.effect == "window_solar_gains" else SOLAR_OPAQUE
+    return solar_orientation_signal(total, orientation)
 
 
 @dataclass
 class Report:
+    """The diagnosis: ``health`` and ``quality`` of the base model as given, ``repair`` the
+    outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
+    extension had to help across (none: judged on the single split)."""
+
     building: Building
     model: str
     boundary: pd.Timestamp
@@ -237,6 +353,10 @@ class Report:
     skipped: dict[str, str]
     whiteness: dict
     wall_time_s: float
+    health: Health | None = None
+    quality: FitQuality | None = None
+    repair: dict | None = None
+    folds: list[Fold] = field(default_factory=list)
 
     @property
     def accepted(self) -> list[Finding]:
@@ -244,18 +364,17 @@ class Report:
 
     def to_dict(self) -> dict:
         split = self.baseline.split
-        verdict = (
-            "missing physics found: " + ", ".join(f.effect for f in self.accepted)
-            if self.accepted
-            else "nothing missing: no candidate physics improved the later period enough"
-        )
+        baseline = {
+            "model": self.model,
+            "rmse_train": self.baseline.rmse_train,
+            "rmse_test": self.baseline.rmse_test,
+            "parameters": self.baseline.params,
+        }
+        if self.health is not None and self.quality is not None:
+            baseline["health"] = health_dict(self.health, self.quality) | {"repair": self.repair}
+        tz = self.building.location.timezone
         return {
-            "baseline": {
-                "model": self.model,
-                "rmse_train": self.baseline.rmse_train,
-                "rmse_test": self.baseline.rmse_test,
-                "parameters": self.baseline.params,
-            },
+            "baseline": baseline,
             "mismatch": {
                 "summary": self.locate["test"]["summary"],
                 "train": self.locate["train"],
@@ -269,7 +388,14 @@ class Report:
                 "rmse_test": self.final.rmse_test,
                 "parameters": self.final.params,
             },
-            "verdict": verdict,
+            "verdict": verdict(self.findings, self.health),
+            "evidence": {
+                "method": "folds" if self.folds else "split",
+                "folds": [
+                    {"train_start": f.train_start.tz_convert(tz).isoformat(), "test": f.label(tz)}
+                    for f in self.folds
+                ],
+            },
             "skipped": self.skipped,
             "whiteness": self.whiteness,
             "periods": {
@@ -283,21 +409,4 @@ class Report:
         }
 
     def to_json(self, indent: int = 2) -> str:
-        return json.dumps(_plain(self.to_dict()), indent=indent, allow_nan=False)
-
-
-def _plain(value: object) -> object:
-    """JSON-safe copy: numpy scalars and arrays to Python, NaN and ±inf to null."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, bool | np.bool_):
-        return bool(value)
-    if isinstance(value, int | np.integer):
-        return int(value)
-    if isinstance(value, float | np.floating):
-        return float(value) if np.isfinite(value) else None
-    return value
+        return json.dumps(jsonable(self.to_dict()), indent=indent, allow_nan=False)

@@ -49,6 +49,7 @@ class GAResult:
     history: list[float]  # best cost per generation
     evaluations: int
     archive: np.ndarray  # best mutually distinct individuals of the whole run, best first
+    archive_costs: np.ndarray
 
 
 def minimize(
@@ -83,7 +84,9 @@ def minimize(
             np.concatenate([archive_costs, child_costs]),
             settings.archive,
         )
-    return GAResult(pop[0], float(costs[0]), pop, costs, history, evaluations, archive)
+    return GAResult(
+        pop[0], float(costs[0]), pop, costs, history, evaluations, archive, archive_costs
+    )
 
 
 def _initial_population(n: int, settings: GASettings, rng: np.random.Generator) -> np.ndarray:

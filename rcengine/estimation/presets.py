@@ -5,18 +5,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rcengine.estimation.ga import GASettings
+from rcengine.estimation.likelihood import LikelihoodSettings
 from rcengine.estimation.pattern_search import GPSSettings
 
 
 @dataclass(frozen=True)
 class EstimatorSettings:
     """GA and GPS settings; ``polish`` runs a least-squares polish from the GPS optimum and from
-    the next ``polish_starts − 1`` best distinct GA individuals (each a cheap local solve)."""
+    the next ``polish_starts − 1`` best distinct GA individuals (each a cheap local solve);
+    ``likelihood``: the search of ``criterion="likelihood"``."""
 
     ga: GASettings = field(default_factory=GASettings)
     gps: GPSSettings = field(default_factory=GPSSettings)
     polish: bool = False
     polish_starts: int = 1
+    likelihood: LikelihoodSettings = field(default_factory=LikelihoodSettings)
 
 
 PRESETS: dict[str, EstimatorSettings] = {

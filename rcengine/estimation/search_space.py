@@ -58,14 +58,22 @@ class SearchSpace:
         lo = np.where(self.log, np.log(np.where(self.log, self.lower, 1.0)), self.lower)
         hi = np.where(self.log, np.log(np.where(self.log, self.upper, 1.0)), self.upper)
         values = lo + unit * (hi - lo)
-        values = np.where(self.log, np.exp(np.where(self.log, values, 0.0)), values)
-        theta = np.tile(self._template, (unit.shape[0], 1))
+        return self.full(np.where(self.log, np.exp(np.where(self.log, values, 0.0)), values))
+
+    def full(self, values: np.ndarray) -> np.ndarray:
+        """Free parameter values (S, dim) → full parameter arrays (S, p) with the known ones."""
+        values = np.atleast_2d(values)
+        theta = np.tile(self._template, (values.shape[0], 1))
         theta[:, self._free_idx] = values
         return theta
 
+    def free_values(self, theta: np.ndarray) -> np.ndarray:
+        """Full parameter arrays (S, p) → the free parameters' values (S, dim)."""
+        return np.atleast_2d(theta)[:, self._free_idx]
+
     def to_unit(self, theta: np.ndarray) -> np.ndarray:
         """Full parameter arrays (S, p) → unit-cube points (S, dim)."""
-        values = np.atleast_2d(theta)[:, self._free_idx]
+        values = self.free_values(theta)
         with np.errstate(divide="ignore", invalid="ignore"):
             lo = np.where(self.log, np.log(self.lower), self.lower)
             hi = np.where(self.log, np.log(self.upper), self.upper)

@@ -121,23 +121,34 @@ def read_eplusout(
     ------
     ValueError : a needed variable is missing, a zone is unknown, or the steps are irregular.
     """
-    raw = pd.read_csv(path)
-    ends, order = _end_times(raw.iloc[:, 0], year)
-    raw = raw.iloc[order].reset_index(drop=True)
-    step = _regular_step(ends)
-    columns = _parse_header(raw.columns[1:])
-
+    raw, columns, local, step = _read_in_order(path, year)
     averaged = _averaged_variables(raw, columns)
     t_in = _zone_temperature(raw, columns, zones)
 
-    local = pd.DatetimeIndex(ends)
     # Averages belong to the interval that ends at their stamp; the temperature to its stamp.
     inputs = pd.DataFrame(averaged, index=local - step)
     state = pd.Series(t_in, index=local, name=T_IN)
     frame = inputs.join(state, how="inner")
-    frame.index = (frame.index - pd.Timedelta(hours=tz_offset_h)).tz_localize("UTC")
-    frame.index.name = TIME
+    frame.index = _utc(frame.index, tz_offset_h)
     return frame[[c for c in CONTRACT_ORDER if c in frame.columns]]
+
+
+def read_rates(path: str | Path, variable: str, *, year: int, tz_offset_h: float) -> pd.DataFrame:
+    """One averaged EnergyPlus variable (e.g. ``Zone Ideal Loads Zone Sensible Heating Rate``)
+    of every key that reports it, one column per key (upper case, as EnergyPlus writes it),
+    indexed by the UTC start of each interval. ``year`` and ``tz_offset_h`` as for
+    :func:`read_eplusout`.
+
+    Raises
+    ------
+    ValueError : no key reports ``variable``, or the steps are irregular.
+    """
+    raw, columns, local, step = _read_in_order(path, year)
+    rates = _select(raw, columns, variable)
+    if rates.empty:
+        raise ValueError(f"eplusout.csv has no '{variable}' output")
+    rates.index = _utc(local - step, tz_offset_h)
+    return rates
 
 
 def write_contract_csv(frame: pd.DataFrame, path: str | Path, tz_offset_h: float) -> None:
@@ -164,6 +175,25 @@ def _compact(values: np.ndarray, decimals: int) -> list[str]:
 
 
 # --- helpers --------------------------------------------------------------------------------
+
+
+def _read_in_order(
+    path: str | Path, year: int
+) -> tuple[pd.DataFrame, list[tuple[str, str]], pd.DatetimeIndex, pd.Timedelta]:
+    """Rows in simulation order, (key, variable) of each data column, local standard-time end
+    of each row's timestep, the timestep."""
+    raw = pd.read_csv(path)
+    ends, order = _end_times(raw.iloc[:, 0], year)
+    raw = raw.iloc[order].reset_index(drop=True)
+    step = _regular_step(ends)
+    return raw, _parse_header(raw.columns[1:]), pd.DatetimeIndex(ends), step
+
+
+def _utc(local: pd.DatetimeIndex, tz_offset_h: float) -> pd.DatetimeIndex:
+    """Local standard times as a UTC index named ``time``."""
+    out = (local - pd.Timedelta(hours=tz_offset_h)).tz_localize("UTC")
+    out.name = TIME
+    return out
 
 
 def _parse_header(names: pd.Index) -> list[tuple[str, str]]:

@@ -2,10 +2,12 @@
 slices, forecast starts, service query parameters).
 
 Accepted forms: an ISO 8601 instant with a UTC offset (``2017-01-09T06:15:00+01:00``, ``...Z``),
-or — where a building's time zone is given — a local date (``2017-01-09``) or a local date-time
-without offset, read as the wall-clock time in that zone. A ``+`` turned into a space by URL
-decoding (``...T06:15:00 01:00``) is put back. Times outside pandas' nanosecond range
-(1677-09-21 … 2262-04-11) are refused, not wrapped.
+or — where a building's time zone is given — a local date (``2017-01-09``, the start of that day)
+or a local date-time without offset, read as the wall-clock time in that zone. A ``+`` turned
+into a space by URL decoding (``...T06:15:00 01:00``) is put back. Other spellings pandas would
+guess at (``now``, ``9/1/2017``) are refused; so are local times the clocks skip or repeat at a
+change of offset, and times outside pandas' nanosecond range (1677-09-21 … 2262-04-11), which
+would wrap.
 """
 
 from __future__ import annotations
@@ -16,8 +18,12 @@ import pandas as pd
 
 from rcengine.exceptions import DataValidationError, Problem
 
-_PLUS_AS_SPACE = re.compile(r"^(\S+T\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?) (\d{2}:?\d{2})$")
-_DATE_ONLY = re.compile(r"^\d{4}-\d{2}-\d{2}$")
+_DATE = r"\d{4}-\d{2}-\d{2}"
+_TIME = r"\d{2}(?::\d{2}(?::\d{2}(?:[.,]\d+)?)?)?"
+_PLUS_AS_SPACE = re.compile(rf"^({_DATE}[T ]{_TIME}) (\d{{2}}:?\d{{2}})$")
+# ISO 8601 extended form: a date, optionally a time, optionally a UTC offset.
+_ISO_8601 = re.compile(rf"^{_DATE}(?:[T ]{_TIME})?(?:Z|[+-]\d{{2}}(?::?\d{{2}})?)?$")
+_DATE_ONLY = re.compile(rf"^{_DATE}$")
 
 
 def parse_instant(value: object, name: str = "time", timezone: str | None = None) -> pd.Timestamp:
@@ -36,9 +42,11 @@ def parse_instant(value: object, name: str = "time", timezone: str | None = None
     ------
     DataValidationError : one problem naming ``name`` when the value is no such instant.
     """
-    text = str(value).strip() if isinstance(value, str) else value
-    if isinstance(text, str):
-        text = _PLUS_AS_SPACE.sub(r"\1+\2", text)
+    text = value
+    if isinstance(value, str):
+        text = _PLUS_AS_SPACE.sub(r"\1+\2", value.strip())
+        if not _ISO_8601.match(text):
+            raise _invalid(value, name, timezone, "")
     try:
         stamp = pd.Timestamp(text)
     except (ValueError, TypeError, OverflowError) as exc:
@@ -48,10 +56,7 @@ def parse_instant(value: object, name: str = "time", timezone: str | None = None
     if stamp.tzinfo is None:
         if timezone is None:
             raise _invalid(value, name, timezone, " (no UTC offset)")
-        try:
-            stamp = stamp.tz_localize(timezone, ambiguous="raise", nonexistent="raise")
-        except (ValueError, TypeError, OverflowError) as exc:
-            raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+        stamp = _localize(stamp, value, name, timezone)
     try:
         return stamp.tz_convert("UTC").as_unit("ns")
     except (ValueError, OverflowError) as exc:
@@ -63,11 +68,38 @@ def is_local_date(value: object) -> bool:
     return isinstance(value, str) and bool(_DATE_ONLY.match(value.strip()))
 
 
+def _localize(stamp: pd.Timestamp, value: object, name: str, timezone: str) -> pd.Timestamp:
+    """The wall-clock ``stamp`` in ``timezone``: a date is the start of that local day (after
+    any gap the clocks skip); a time the clocks skip or repeat is refused."""
+    day = is_local_date(value)
+    try:
+        local = stamp.tz_localize(
+            timezone,
+            ambiguous=True if day else "NaT",
+            nonexistent="shift_forward" if day else "NaT",
+        )
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+    if pd.isna(local):
+        wall = f"{stamp:%Y-%m-%d %H:%M}"
+        skipped = pd.isna(stamp.tz_localize(timezone, ambiguous=True, nonexistent="NaT"))
+        why = (
+            f"the clocks of {timezone} skip {wall}"
+            if skipped
+            else f"{wall} happens twice in {timezone}; give the UTC offset"
+        )
+        raise _invalid(value, name, timezone, f" ({why})")
+    return local
+
+
 def _reason(exc: BaseException) -> str:
     text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     if "overflow" in text.lower() or "out of bounds" in text.lower():
         return "outside the supported range 1677-09-22 … 2262-04-11"
-    return text
+    if "tzoffset" in text:
+        return "a UTC offset lies within ±24 h"
+    # pandas ends some messages with the text parsed, already quoted in ours.
+    return re.sub(r": [^:]*\d{4}-\d{2}-\d{2}\S*$", "", text)
 
 
 def _invalid(value: object, name: str, timezone: str | None, why: str) -> DataValidationError:

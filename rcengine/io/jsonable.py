@@ -1,32 +1,53 @@
-"""The one numpy/pandas-to-JSON hook: ``json.dumps(obj, default=jsonable)``."""
+"""JSON in and out: the one numpy/pandas-to-JSON hook, ``json.dumps(obj, default=jsonable)``,
+and ``read_json``, which turns a file that does not parse into the caller's one-line error."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
 
 def jsonable(value: object) -> object:
-    """A JSON-native equivalent of ``value`` (numpy arrays and scalars, timestamps); non-finite
+    """A JSON-native copy of ``value``: dicts (keys as text) and lists/tuples item by item,
+    numpy arrays and scalars as Python lists and numbers, timestamps as ISO 8601; non-finite
     floats become ``None`` so the output is strict JSON.
+
+    ``json.dumps(jsonable(obj))`` nulls every NaN; as ``json.dumps(obj, default=jsonable)`` it
+    converts what ``json`` cannot, but ``json`` never hands it a Python float, whose NaN it writes.
 
     Raises
     ------
     TypeError : for anything else, as ``json.dumps`` expects of a ``default`` hook.
     """
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if isinstance(value, float):
+        return float(value) if math.isfinite(value) else None
+    if value is None or isinstance(value, str | int):
+        return value
     if isinstance(value, pd.Timestamp):
         return value.isoformat()
     if hasattr(value, "tolist"):
-        return _finite(value.tolist())
+        return jsonable(value.tolist())
     if hasattr(value, "item"):
-        return _finite(value.item())
+        return jsonable(value.item())
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
-def _finite(value: object) -> object:
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, list):
-        return [_finite(v) for v in value]
-    return value
+def read_json(path: str | Path, error: type[Exception]) -> Any:
+    """The JSON document in the file at ``path``.
+
+    Raises
+    ------
+    error : ``"<path>: not valid JSON (<where>)"`` when it does not parse.
+    """
+    try:
+        return json.loads(Path(path).read_text())
+    except json.JSONDecodeError as exc:
+        raise error(f"{path}: not valid JSON ({exc})") from exc

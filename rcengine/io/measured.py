@@ -44,6 +44,7 @@ import numpy as np
 import pandas as pd
 
 from rcengine.columns import GHI, Q_HVAC, T_IN, T_OUT, TIME
+from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import validate_frame
 
 SYSLAB_START = "2009-02-05T14:26:00+00:00"
@@ -104,8 +105,6 @@ def _contract_frame(
 ) -> pd.DataFrame:
     """Rows at ``start + elapsed`` (rounded to the second: hours as decimals are inexact),
     checked by the contract's own validation."""
-    origin = pd.Timestamp(start)
-    if origin.tz is None:
-        raise ValueError(f"start {start!r} needs a UTC offset, e.g. '{SYSLAB_START}'")
+    origin = parse_instant(start, "start")
     times = origin + pd.to_timedelta(np.round(elapsed_s), unit="s")
     return validate_frame(pd.DataFrame({TIME: times, **columns}))

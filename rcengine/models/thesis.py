@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Collection
 
 from rcengine.building import Building
-from rcengine.columns import GHI, T_OUT
+from rcengine.columns import GHI, SOLAR_OPAQUE, SOLAR_WINDOW, T_OUT
 from rcengine.exceptions import BuildingError
 from rcengine.models.common import (
     THESIS_FLOOR_AREA_M2,
@@ -21,9 +21,6 @@ from rcengine.models.common import (
     add_internal_gains,
 )
 from rcengine.network import Parameter, RCNetwork
-
-SOLAR_WINDOW = "solar_window"
-SOLAR_OPAQUE = "solar_opaque"
 
 
 def _mass_area(building: Building) -> float:

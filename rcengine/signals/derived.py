@@ -14,11 +14,23 @@ import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
-from rcengine.columns import NUMERIC_COLUMNS, T_OUT, WIND_SPEED
+from rcengine.columns import (
+    NUMERIC_COLUMNS,
+    SKY_DELTA,
+    T_GROUND,
+    T_OUT,
+    UNIT,
+    VENT_LOSS,
+    VENT_SCHEDULE,
+    WIND_LOSS,
+    WIND_SPEED,
+    schedule_signal_name,
+)
 from rcengine.dataset import Dataset
 from rcengine.exceptions import ModelError
-from rcengine.signals.ground import ground_temperature
+from rcengine.signals.ground import seasonal_ground_temperature
 from rcengine.signals.schedules import Zone, clock_zone, schedule_signal
+from rcengine.signals.solar import solar_gains, solar_signal_names
 
 # Indoor reference of the air-exchange loss signals: loss ∝ rate × (T_REF − t_out). [°C]
 # The true indoor temperature varies by a few kelvin around it; the fitted gain absorbs the mean.
@@ -54,8 +66,6 @@ Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
 
 
 def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    from rcengine.signals.solar import solar_gains
-
     return solar_gains(
         frame,
         building,
@@ -72,18 +82,22 @@ def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
     return frame[column].to_numpy(dtype=float)
 
 
-def _air_exchange(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """wind_loss = wind_speed · (t_out − T_REF) [m/s·K]; vent_loss = sched · (t_out − T_REF) [K]."""
+def _wind_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """wind_loss = wind_speed · (t_out − T_REF). [m/s·K]"""
     t_out = frame[T_OUT].to_numpy(dtype=float)
-    out = pd.DataFrame(index=frame.index)
-    if WIND_SPEED in frame.columns:
-        out["wind_loss"] = _require(frame, WIND_SPEED, "wind_loss") * (t_out - T_REF_C)
-    if "vent" in options.schedules:
-        schedule = schedule_signal(
-            options.schedules["vent"], frame.index, options.schedule_zone(building)
-        )
-        out["vent_loss"] = schedule * (t_out - T_REF_C)
-    return out
+    wind = _require(frame, WIND_SPEED, WIND_LOSS)
+    return pd.DataFrame({WIND_LOSS: wind * (t_out - T_REF_C)}, index=frame.index)
+
+
+def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """vent_loss = vent schedule · (t_out − T_REF). [K]"""
+    if VENT_SCHEDULE not in options.schedules:
+        raise ModelError(f"signal '{VENT_LOSS}' needs a '{VENT_SCHEDULE}' schedule")
+    t_out = frame[T_OUT].to_numpy(dtype=float)
+    schedule = schedule_signal(
+        options.schedules[VENT_SCHEDULE], frame.index, options.schedule_zone(building)
+    )
+    return pd.DataFrame({VENT_LOSS: schedule * (t_out - T_REF_C)}, index=frame.index)
 
 
 def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
@@ -91,7 +105,7 @@ def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) 
     tz = options.schedule_zone(building)
     return pd.DataFrame(
         {
-            f"sched_{name}": schedule_signal(p, frame.index, tz)
+            schedule_signal_name(name): schedule_signal(p, frame.index, tz)
             for name, p in options.schedules.items()
         },
         index=frame.index,
@@ -99,9 +113,16 @@ def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) 
 
 
 def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    step = float(np.median(np.diff(frame.index.as_unit("s").asi8)))
+    """t_ground: the outdoor annual cycle damped and lagged into the soil [°C] (its mean is
+    fitted on top, through a constant heat input on ``unit``); unit = 1 [-]."""
+    t_out = frame[T_OUT].to_numpy(dtype=float)
+    latitude = building.location.latitude
     return pd.DataFrame(
-        {"t_ground": ground_temperature(frame[T_OUT].to_numpy(), step)}, index=frame.index
+        {
+            T_GROUND: seasonal_ground_temperature(frame.index, t_out, latitude),
+            UNIT: np.ones(len(frame)),
+        },
+        index=frame.index,
     )
 
 
@@ -111,18 +132,21 @@ def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.
 
     t_out = frame[T_OUT].to_numpy(dtype=float)
     cover = daily_cloud_cover(frame, building.location)
-    return pd.DataFrame({"sky_delta": sky_temperature(t_out, cover) - t_out}, index=frame.index)
+    return pd.DataFrame({SKY_DELTA: sky_temperature(t_out, cover) - t_out}, index=frame.index)
 
 
-# Prefix of a derived signal name → the function computing every signal of that family.
-DERIVERS: dict[str, Deriver] = {
-    "solar_": _solar,
-    "wind_loss": _air_exchange,
-    "vent_loss": _air_exchange,
-    "sched_": _schedules,
-    "t_ground": _ground,
-    "sky_delta": _sky,
-}
+def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
+    """Every signal derivable for ``building`` with ``options`` → the function computing it
+    (one function may compute several signals: it then runs once for all of them)."""
+    return {
+        **dict.fromkeys(solar_signal_names(building), _solar),
+        WIND_LOSS: _wind_loss,
+        VENT_LOSS: _vent_loss,
+        **{schedule_signal_name(name): _schedules for name in options.schedules},
+        T_GROUND: _ground,
+        UNIT: _ground,
+        SKY_DELTA: _sky,
+    }
 
 
 def derive(
@@ -130,16 +154,12 @@ def derive(
 ) -> pd.DataFrame:
     """Compute the requested derived signals (columns already in ``frame`` are left alone)."""
     wanted = [n for n in dict.fromkeys(names) if n not in frame.columns]
+    by_name = derivers(building, options)
     out = pd.DataFrame(index=frame.index)
-    for prefix, deriver in DERIVERS.items():
-        family = [n for n in wanted if n.startswith(prefix)]
-        if not family:
-            continue
-        computed = deriver(frame, building, options)
-        missing = [n for n in family if n not in computed.columns]
-        if missing:
-            raise ModelError(f"cannot derive signal(s) {missing}; available: {list(computed)}")
-        out = out.join(computed[family])
+    for deriver in dict.fromkeys(by_name.values()):
+        family = [n for n in wanted if by_name.get(n) is deriver]
+        if family:
+            out = out.join(deriver(frame, building, options)[family])
     unknown = [n for n in wanted if n not in out.columns]
     if unknown:
         absent = [n for n in unknown if n in NUMERIC_COLUMNS]

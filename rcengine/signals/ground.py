@@ -1,17 +1,46 @@
 """A slowly varying ground temperature for floors in contact with the soil.
 
 Below a slab the soil damps the daily and weekly swings of the air temperature and lags its
-seasonal swing (Kusuda & Achenbach 1965). Without soil data, an exponentially weighted running
-mean of the outdoor temperature with a time constant of about a month reproduces that behaviour
-at the shallow depths that exchange heat with a floor.
+seasonal swing (Kusuda & Achenbach 1965). Two estimates:
+
+- ``seasonal_ground_temperature``: the outdoor annual cycle T_m − A·cos(ω(t − t_cold)), read from
+  the record, carried down into the soil as a periodic wave: T_g(t) = T_m − A·e^(−z/δ)·cos(ω(t −
+  t_cold) − z/δ) (the solution of the 1-D heat equation in a semi-infinite soil, ISO 13370:2017
+  Annex; Kusuda & Achenbach 1965), with δ = √(λ·P/(π·ρc)) the periodic penetration depth. The
+  diagnosis fits the mean on top of it (a heated building warms the soil under it);
+- ``ground_temperature``: an exponentially weighted running mean of the outdoor temperature (a
+  month's time constant), the older, shorter-memory estimate.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import pandas as pd
 from scipy.signal import lfilter
 
 GROUND_TAU_DAYS = 30.0
+# Annual period. [s]
+YEAR_S = 365.2425 * 86400.0
+# Periodic penetration depth of the annual wave in sand or gravel, λ = 2.0 W/(mK), ρc = 2.0e6
+# J/(m³K): ISO 13370:2017 Table 7 (δ = 3.2 m; 2.2 m in clay, 4.2 m in rock); the standard's
+# soil when the soil is unknown. [m]
+SOIL_PENETRATION_DEPTH_M = 3.2
+# Depth of soil between a slab and the undisturbed ground it exchanges with: one penetration depth
+# (the scale of ISO 13370's periodic floor coefficients), damping the outdoor swing to 1/e and
+# lagging it by a radian (≈ 58 days). [m]
+GROUND_DEPTH_M = SOIL_PENETRATION_DEPTH_M
+# Coldest day of the outdoor annual cycle: about 25 days after the winter solstice in mid-latitude
+# climates (day of year, northern hemisphere; half a year later in the southern). [d]
+COLDEST_DAY_OF_YEAR = 15.0
+# The cycle's amplitude is read only from a record whose cos(2π(t − t_cold)/year) spans at least
+# this much (about two months away from the coldest day): nearer, mean and amplitude are one
+# number. [-]
+MIN_CYCLE_SPREAD = 0.5
+# Largest annual amplitude of monthly mean air temperatures on Earth (≈ 30 K in eastern Siberia);
+# a fit beyond it is the weather of one record, not a climate. [K]
+MAX_ANNUAL_AMPLITUDE_K = 30.0
 
 
 def ground_temperature(
@@ -36,3 +65,57 @@ def ground_temperature(
     start = float(np.mean(t_out[:n_tau]))
     out, _ = lfilter([1.0 - a], [1.0, -a], t_out, zi=[a * start])
     return out
+
+
+@dataclass(frozen=True)
+class AnnualCycle:
+    """Outdoor annual cycle T_m − A·cos(2π(t − coldest)/year): mean [°C], amplitude [K] (≥ 0)
+    and the instant of its minimum."""
+
+    mean: float
+    amplitude: float
+    coldest: pd.Timestamp
+
+    def phase(self, times: pd.DatetimeIndex) -> np.ndarray:
+        """2π(t − coldest)/year at ``times``. [rad]"""
+        return 2.0 * np.pi * (times - self.coldest).total_seconds().to_numpy() / YEAR_S
+
+
+def annual_cycle(times: pd.DatetimeIndex, t_out: np.ndarray, latitude: float) -> AnnualCycle:
+    """Least-squares mean and amplitude of the annual cycle through ``t_out`` [°C] at ``times``,
+    its phase fixed by the hemisphere (``COLDEST_DAY_OF_YEAR``): a record of a few months cannot
+    place the minimum, but can tell how much warmer its spring is than its winter.
+
+    The amplitude is kept within 0–``MAX_ANNUAL_AMPLITUDE_K`` (a record whose trend runs against
+    the season gives a flat cycle) and is 0 when the record spans too little of the cycle
+    (``MIN_CYCLE_SPREAD``); the mean is then the one that goes with it.
+    """
+    days = COLDEST_DAY_OF_YEAR + (0.0 if latitude >= 0 else YEAR_S / 2 / 86400.0)
+    first = times[0].tz_convert("UTC")
+    coldest = pd.Timestamp(year=first.year, month=1, day=1, tz="UTC") + pd.Timedelta(days=days)
+    cycle = AnnualCycle(0.0, 0.0, coldest)
+    t_out = np.asarray(t_out, dtype=float)
+    ok = np.isfinite(t_out)
+    shape = np.cos(cycle.phase(times))[ok]
+    amplitude = 0.0
+    if np.ptp(shape) >= MIN_CYCLE_SPREAD:
+        design = np.column_stack([np.ones(shape.size), -shape])
+        amplitude = np.linalg.lstsq(design, t_out[ok], rcond=None)[0][1]
+    amplitude = float(np.clip(amplitude, 0.0, MAX_ANNUAL_AMPLITUDE_K))
+    return AnnualCycle(float(np.mean(t_out[ok] + amplitude * shape)), amplitude, coldest)
+
+
+def seasonal_ground_temperature(
+    times: pd.DatetimeIndex,
+    t_out: np.ndarray,
+    latitude: float,
+    depth_m: float = GROUND_DEPTH_M,
+) -> np.ndarray:
+    """The outdoor annual cycle damped and lagged ``depth_m`` into the soil. [°C]
+
+    T_g(t) = T_m − A·e^(−z/δ)·cos(2π(t − t_cold)/year − z/δ), z = ``depth_m``, δ =
+    ``SOIL_PENETRATION_DEPTH_M``, T_m, A and t_cold from ``annual_cycle``.
+    """
+    cycle = annual_cycle(times, t_out, latitude)
+    depth = depth_m / SOIL_PENETRATION_DEPTH_M
+    return cycle.mean - cycle.amplitude * np.exp(-depth) * np.cos(cycle.phase(times) - depth)

@@ -22,7 +22,15 @@ import pandas as pd
 from pvlib import atmosphere, clearsky, iam, irradiance, solarposition
 
 from rcengine.building import Building, Location, Surface
-from rcengine.columns import DHI, DNI, GHI
+from rcengine.columns import (
+    DHI,
+    DNI,
+    GHI,
+    SOLAR_OPAQUE,
+    SOLAR_WINDOW,
+    orientation_key,
+    solar_orientation_signal,
+)
 
 DECOMPOSITION_MODELS = ("erbs", "dirint")
 SKY_MODELS = ("isotropic", "perez", "haydavies")
@@ -43,17 +51,6 @@ MAX_CLEAR_SKY_INDEX = 1.5
 def _check_model(model: str, choices: tuple[str, ...]) -> None:
     if model not in choices:
         raise ValueError(f"invalid model {model}; choose from {', '.join(choices)}")
-
-
-def orientation_key(azimuth: float, tilt: float) -> str:
-    """Suffix naming a surface orientation in signal columns, e.g. ``90_90`` (east, vertical).
-
-    Parameters
-    ----------
-    azimuth : clockwise from north. [°]
-    tilt : from horizontal. [°]
-    """
-    return f"{azimuth:g}_{tilt:g}"
 
 
 def interval_midpoints(index: pd.DatetimeIndex) -> pd.DatetimeIndex:
@@ -312,6 +309,20 @@ def _group_by_orientation(surfaces: tuple[Surface, ...]) -> dict[str, tuple[Surf
     return groups
 
 
+def solar_signal_names(building: Building) -> list[str]:
+    """The columns ``solar_gains`` gives for ``building``: the two totals, then one per
+    orientation of its windows and of its walls."""
+    surfaces = {SOLAR_WINDOW: building.windows, SOLAR_OPAQUE: building.walls}
+    return [
+        *surfaces,
+        *(
+            solar_orientation_signal(total, key)
+            for total, group in surfaces.items()
+            for key in _group_by_orientation(group)
+        ),
+    ]
+
+
 def solar_gains(
     frame: pd.DataFrame,
     building: Building,
@@ -365,17 +376,18 @@ def solar_gains(
     walls = _group_by_orientation(building.walls)
     planes = {key: plane(s) for key, (s, _) in {**walls, **windows}.items()}
     per_window = {
-        f"solar_window_{key}": area * _glazing_irradiance(planes[key], s.tilt, iam_model)
+        solar_orientation_signal(SOLAR_WINDOW, key): area
+        * _glazing_irradiance(planes[key], s.tilt, iam_model)
         for key, (s, area) in windows.items()
     }
     per_wall = {
-        f"solar_opaque_{key}": area * planes[key]["poa_global"].to_numpy()
+        solar_orientation_signal(SOLAR_OPAQUE, key): area * planes[key]["poa_global"].to_numpy()
         for key, (_, area) in walls.items()
     }
     zeros = np.zeros(len(frame))
     totals = {
-        "solar_window": sum(per_window.values(), zeros),
-        "solar_opaque": sum(per_wall.values(), zeros),
+        SOLAR_WINDOW: sum(per_window.values(), zeros),
+        SOLAR_OPAQUE: sum(per_wall.values(), zeros),
     }
     return pd.DataFrame({**totals, **per_window, **per_wall}, index=frame.index)
 

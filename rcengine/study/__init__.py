@@ -1,2 +1,3 @@
-"""The thesis's rolling learn/predict study: ``run`` (tasks and workers), ``report`` (tables
-and files), ``figures`` (the thesis's figures)."""
+"""The thesis's rolling learn/predict study: ``run`` (tasks and workers), ``analysis`` (tables,
+summary, Sun versus Basic, free-floating validation), ``report`` (files), ``figures`` (the
+thesis's figures)."""

@@ -8,17 +8,17 @@ from pathlib import Path
 import pandas as pd
 
 from rcengine.building import Building
+from rcengine.io.jsonable import jsonable
 from rcengine.study import figures as figs
-from rcengine.study.run import (
-    StudySettings,
+from rcengine.study.analysis import (
     daily_clearness,
-    example,
     free_floating,
     solar_signal_correlation,
     summary,
     sun_vs_basic,
     tables,
 )
+from rcengine.study.run import StudySettings, example
 
 # Thesis Table 3.2 and 3.3: free-floating 12-day validation of the ISO models and the thesis 3R3C.
 THESIS_FREE_FLOATING = {
@@ -62,7 +62,7 @@ def write_study(
         info["free_floating"], paths = _free_floating(free, building, settings, fig_dir)
         written += paths
     path = output / "summary.json"
-    path.write_text(json.dumps(info, indent=2, default=float) + "\n")
+    path.write_text(json.dumps(jsonable(info), indent=2) + "\n")
     written.append(path)
     return written
 

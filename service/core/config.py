@@ -9,8 +9,7 @@ from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
 
-from rcengine.diagnose import DiagnoseSettings
-from rcengine.estimation import PRESETS
+from rcengine.estimation.presets import PRESETS
 from rcengine.models import MODELS
 
 # A shorter admin token is guessable; generated tokens have 43 characters.
@@ -54,8 +53,10 @@ class Settings(BaseSettings):
         description="Days of record a diagnosis covers by default, ending at the last measured "
         "t_in (clipped to the stored data).",
     )
-    diagnosis_preset: str = Field(
-        DiagnoseSettings.preset, description="Estimator preset of every fit of a diagnosis."
+    diagnosis_preset: str | None = Field(
+        None,
+        description="Estimator preset of every fit of a diagnosis (default: the engine's, "
+        "study).",
     )
     max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="Request size limit.")
     workers: int = Field(
@@ -86,8 +87,8 @@ class Settings(BaseSettings):
 
     @field_validator("preset", "diagnosis_preset")
     @classmethod
-    def _known_preset(cls, value: str) -> str:
-        if value not in PRESETS:
+    def _known_preset(cls, value: str | None) -> str | None:
+        if value is not None and value not in PRESETS:
             raise ValueError(f"invalid preset {value!r}; choose from {sorted(PRESETS)}")
         return value
 
@@ -106,10 +107,6 @@ class Settings(BaseSettings):
     def _parsable_url(cls, value: str) -> str:
         make_url(value)  # raises ArgumentError on a malformed URL
         return value
-
-    @property
-    def is_sqlite(self) -> bool:
-        return make_url(self.database_url).get_backend_name() == "sqlite"
 
     @property
     def sqlite_path(self) -> Path | None:

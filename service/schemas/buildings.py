@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
+
+from .common import LocalTime, with_examples
 
 EXAMPLE = {
     "name": "office-torino",
@@ -22,6 +24,20 @@ EXAMPLE = {
     ],
     "walls": [{"azimuth": 0.0, "tilt": 90.0, "area": 63.0}],
 }
+READ_EXAMPLE = {
+    "id": 1,
+    "name": "office-torino",
+    "timezone": "Europe/Rome",
+    "description": EXAMPLE,
+    "created_at": "2017-01-09T06:15:00+01:00",
+    "step_s": 900.0,
+    "rows": 2112,
+    "first_time": "2017-01-09T00:00:00+01:00",
+    "last_time": "2017-01-30T23:45:00+01:00",
+    "last_measured_time": "2017-01-29T23:45:00+01:00",
+    "data_revision": 3,
+    "current_parameter_set_id": 2,
+}
 
 
 class SurfaceIn(BaseModel):
@@ -40,7 +56,7 @@ class LocationIn(BaseModel):
 class BuildingCreate(BaseModel):
     """CONTRACT.md §2. Ranges are checked by ``rcengine.building.Building.from_dict``."""
 
-    model_config = ConfigDict(json_schema_extra={"examples": [EXAMPLE]})
+    model_config = with_examples(EXAMPLE)
 
     name: str = Field("building", max_length=200)
     location: LocationIn
@@ -55,31 +71,23 @@ class BuildingCreate(BaseModel):
 class BuildingCreated(BaseModel):
     """The building's token is shown here once; the service keeps only its hash."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "id": 1,
-                    "name": "office-torino",
-                    "token": "0b3Xq1u8Yf3n8m0c2r3vJ8b9J1ZKq7w3fX4o5p6q7r8",
-                    "created_at": "2017-01-09T06:15:00+01:00",
-                }
-            ]
+    model_config = with_examples(
+        {
+            "id": 1,
+            "name": "office-torino",
+            "token": "0b3Xq1u8Yf3n8m0c2r3vJ8b9J1ZKq7w3fX4o5p6q7r8",
+            "created_at": "2017-01-09T06:15:00+01:00",
         }
     )
 
     id: int
     name: str
     token: str = Field(description="Bearer token for this building's calls; shown only once")
-    created_at: str
+    created_at: LocalTime
 
 
 class TokenRotated(BaseModel):
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [{"id": 1, "token": "mS0n2r9vJ8b9J1ZKq7w3fX4o5p6q7r80b3Xq1u8Yf3n"}]
-        }
-    )
+    model_config = with_examples({"id": 1, "token": "mS0n2r9vJ8b9J1ZKq7w3fX4o5p6q7r80b3Xq1u8Yf3n"})
 
     id: int
     token: str
@@ -88,46 +96,23 @@ class TokenRotated(BaseModel):
 class BuildingRead(BaseModel):
     """A building with a summary of its stored data and current parameter set."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "id": 1,
-                    "name": "office-torino",
-                    "timezone": "Europe/Rome",
-                    "description": EXAMPLE,
-                    "created_at": "2017-01-09T06:15:00+01:00",
-                    "step_s": 900.0,
-                    "rows": 2112,
-                    "first_time": "2017-01-09T00:00:00+01:00",
-                    "last_time": "2017-01-30T23:45:00+01:00",
-                    "last_measured_time": "2017-01-29T23:45:00+01:00",
-                    "data_revision": 3,
-                    "current_parameter_set_id": 2,
-                }
-            ]
-        }
-    )
+    model_config = with_examples(READ_EXAMPLE, from_attributes=True)
 
     id: int
     name: str
     timezone: str
     description: dict
-    created_at: str
+    created_at: LocalTime
     step_s: float | None = Field(description="Time step of the stored series. [s]")
     rows: int
-    first_time: str | None
-    last_time: str | None
-    last_measured_time: str | None = Field(description="Latest row with a measured t_in")
+    first_time: LocalTime | None
+    last_time: LocalTime | None
+    last_measured_time: LocalTime | None = Field(description="Latest row with a measured t_in")
     data_revision: int = Field(description="Incremented by every upload")
     current_parameter_set_id: int | None
 
 
 class BuildingList(BaseModel):
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [{"items": BuildingRead.model_config["json_schema_extra"]["examples"]}]
-        }
-    )
+    model_config = with_examples({"items": [READ_EXAMPLE]})
 
     items: list[BuildingRead]

@@ -1,12 +1,42 @@
-"""Bodies shared by every resource: errors, model names."""
+"""Bodies shared by every resource: errors, model names, times in the building's zone."""
 
 from __future__ import annotations
 
-from typing import Annotated
+from datetime import datetime
+from typing import Annotated, Any
 
-from pydantic import AfterValidator, BaseModel, Field
+import pandas as pd
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo
 
+from rcengine.io.timeseries import format_times
 from rcengine.models import MODELS
+
+# Key of the validation context that names the building's time zone (IANA name).
+TIMEZONE = "timezone"
+
+
+def in_zone(timezone: str) -> dict[str, str]:
+    """Validation context that writes a record's times in ``timezone``: a response schema is
+    built as ``Schema.model_validate(record, context=in_zone(building.timezone))``."""
+    return {TIMEZONE: timezone}
+
+
+def _in_building_zone(value: Any, info: ValidationInfo) -> Any:
+    # Text passes: a body already built (FastAPI may validate a response again).
+    if not isinstance(value, datetime):
+        return value
+    if not info.context or TIMEZONE not in info.context:
+        raise ValueError("a time needs the building's time zone as validation context (in_zone)")
+    return format_times(pd.DatetimeIndex([pd.Timestamp(value)]), info.context[TIMEZONE])[0]
+
+
+# A stored instant in an answer: ISO 8601 with the UTC offset of the building's time zone.
+LocalTime = Annotated[str, BeforeValidator(_in_building_zone)]
+
+
+def with_examples(*examples: dict[str, Any], **config: Any) -> ConfigDict:
+    """Model configuration with the examples of the OpenAPI page."""
+    return ConfigDict(json_schema_extra={"examples": list(examples)}, **config)
 
 
 def _known_model(name: str | None) -> str | None:
@@ -38,24 +68,19 @@ class DataErrorRead(BaseModel):
     detail: str
     problems: list[ProblemRead]
 
-    model_config = {
-        "json_schema_extra": {
-            "examples": [
+    model_config = with_examples(
+        {
+            "detail": "invalid data: row 3, column 't_in': 500 °C is outside the physically "
+            "possible range [-30, 60] °C",
+            "problems": [
                 {
-                    "detail": "invalid data: row 3, column 't_in': 500 °C is outside the "
-                    "physically possible range [-30, 60] °C",
-                    "problems": [
-                        {
-                            "row": 3,
-                            "column": "t_in",
-                            "message": "500 °C is outside the physically possible range "
-                            "[-30, 60] °C",
-                        }
-                    ],
+                    "row": 3,
+                    "column": "t_in",
+                    "message": "500 °C is outside the physically possible range [-30, 60] °C",
                 }
-            ]
+            ],
         }
-    }
+    )
 
 
 def error_responses(*codes: int) -> dict[int | str, dict]:

@@ -9,7 +9,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 
 from rcengine.diagnose import DiagnoseSettings
 
-from .common import ModelName
+from .common import LocalTime, ModelName, with_examples
 
 # The effect ids of CONTRACT.md §3 that the engine can test (its default: all of them).
 EFFECTS = DiagnoseSettings().effects
@@ -72,7 +72,7 @@ class DiagnosisRequest(BaseModel):
     """The window is ``days`` before ``end``, or ``start`` to ``end``; ``end`` defaults to one
     step after the last measured t_in. The window is clipped to the stored measured rows."""
 
-    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [REQUEST_EXAMPLE]})
+    model_config = with_examples(REQUEST_EXAMPLE, extra="forbid")
 
     model: ModelName = None
     days: int | None = Field(
@@ -110,20 +110,22 @@ class DiagnosisRequest(BaseModel):
         return self
 
 
-class BaselineRead(BaseModel):
-    """The model as given, fitted on the training part."""
+class ReportPart(BaseModel):
+    """A part of the engine's report: the fields it adds beyond these reach the client too."""
 
     model_config = ConfigDict(extra="allow")
+
+
+class BaselineRead(ReportPart):
+    """The model as given, fitted on the training part."""
 
     model: str
     rmse_train: float | None = Field(description="[K]")
     rmse_test: float | None = Field(description="On the later test period. [K]")
 
 
-class FindingRead(BaseModel):
+class FindingRead(ReportPart):
     """One candidate effect's verdict; the first accepted one is the tool's answer."""
-
-    model_config = ConfigDict(extra="allow")
 
     effect: str
     accepted: bool
@@ -132,17 +134,15 @@ class FindingRead(BaseModel):
     rmse_test_after: float | None = Field(description="None when only screened. [K]")
 
 
-class MismatchRead(BaseModel):
+class MismatchRead(ReportPart):
     """Where and when the baseline's errors concentrate."""
-
-    model_config = ConfigDict(extra="allow")
 
     summary: str
 
 
 class DiagnosisWindow(BaseModel):
-    start: str = Field(description="First row diagnosed")
-    end: str = Field(description="One step after the last row diagnosed")
+    start: LocalTime = Field(description="First row diagnosed")
+    end: LocalTime = Field(description="One step after the last row diagnosed")
     train_fraction: float
 
 
@@ -150,12 +150,12 @@ class DiagnosisRead(BaseModel):
     """The report of ``rcengine diagnose`` (CONTRACT.md §3: every field of the engine's JSON,
     at the top level) plus the service's: id, job, creation time, window, engine settings."""
 
-    model_config = ConfigDict(extra="allow", json_schema_extra={"examples": [DIAGNOSIS_EXAMPLE]})
+    model_config = with_examples(DIAGNOSIS_EXAMPLE, extra="allow")
 
     id: int
     building_id: int
     job_id: int | None
-    created_at: str
+    created_at: LocalTime
     window: DiagnosisWindow
     settings: dict[str, Any] = Field(description="preset, random_state, train_fraction, effects")
     engine_version: str

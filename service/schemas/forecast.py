@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from .common import LocalTime, with_examples
+
 MAX_HORIZON_H = 7 * 24.0
 MAX_CANDIDATES = 1000
 
@@ -21,11 +23,13 @@ TIMES_EXAMPLE = ["2017-01-31T00:00:00+01:00", "2017-01-31T00:15:00+01:00"]
 
 
 class ParameterSetRef(BaseModel):
+    model_config = ConfigDict(from_attributes=True)
+
     id: int
     model: str
-    created_at: str
-    train_start: str
-    train_end: str
+    created_at: LocalTime
+    train_start: LocalTime
+    train_end: LocalTime
     rmse_train: float | None = Field(description="[K]")
     rmse_holdout: float | None = Field(description="[K]")
     engine_version: str
@@ -34,17 +38,13 @@ class ParameterSetRef(BaseModel):
 class ForecastRead(BaseModel):
     """Indoor temperature at each row start; times in the building's time zone."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "times": TIMES_EXAMPLE,
-                    "t_in_pred": [20.61, 20.55],
-                    "parameter_set": SET_REF_EXAMPLE,
-                    "step_s": 900.0,
-                    "unit": "°C",
-                }
-            ]
+    model_config = with_examples(
+        {
+            "times": TIMES_EXAMPLE,
+            "t_in_pred": [20.61, 20.55],
+            "parameter_set": SET_REF_EXAMPLE,
+            "step_s": 900.0,
+            "unit": "°C",
         }
     )
 
@@ -59,16 +59,12 @@ class SimulateRequest(BaseModel):
     """Candidate HVAC heat trajectories from ``start``; the other inputs (weather, gains) are
     the stored future rows. One candidate (a list) or many (a list of lists), each H steps."""
 
-    model_config = ConfigDict(
-        extra="forbid",
-        json_schema_extra={
-            "examples": [
-                {
-                    "start": "2017-01-31T00:00:00+01:00",
-                    "q_hvac": [[0.0, 0.0, 30000.0, 30000.0], [20000.0, 20000.0, 20000.0, 0.0]],
-                }
-            ]
+    model_config = with_examples(
+        {
+            "start": "2017-01-31T00:00:00+01:00",
+            "q_hvac": [[0.0, 0.0, 30000.0, 30000.0], [20000.0, 20000.0, 20000.0, 0.0]],
         },
+        extra="forbid",
     )
 
     start: str | None = Field(
@@ -80,17 +76,13 @@ class SimulateRequest(BaseModel):
 
 
 class SimulateRead(BaseModel):
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "times": TIMES_EXAMPLE,
-                    "t_in": [[20.61, 20.55], [20.72, 20.80]],
-                    "parameter_set": SET_REF_EXAMPLE,
-                    "step_s": 900.0,
-                    "unit": "°C",
-                }
-            ]
+    model_config = with_examples(
+        {
+            "times": TIMES_EXAMPLE,
+            "t_in": [[20.61, 20.55], [20.72, 20.80]],
+            "parameter_set": SET_REF_EXAMPLE,
+            "step_s": 900.0,
+            "unit": "°C",
         }
     )
 
@@ -102,7 +94,7 @@ class SimulateRead(BaseModel):
 
 
 class StateEstimate(BaseModel):
-    time: str = Field(description="The state is at the start of this step")
+    time: LocalTime = Field(description="The state is at the start of this step")
     x: list[float] = Field(description="Node temperatures, in state_names order [°C]")
     std: list[float] = Field(description="Their standard deviation from the Kalman filter [K]")
     t_in: float = Field(description="C·x: the indoor temperature the state implies [°C]")
@@ -111,32 +103,28 @@ class StateEstimate(BaseModel):
 class ModelRead(BaseModel):
     """x[k+1] = A x[k] + B u[k],  t_in[k] = C x[k] + D u[k]  (zero-order hold, step dt)."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "A": [[0.98, 0.01, 0.0], [0.02, 0.95, 0.03], [0.0, 0.04, 0.96]],
-                    "B": [
-                        [0.01, 1e-5, 0.0, 0.0, 0.0],
-                        [0.0, 0.0, 1.7e-4, 1.7e-4, 0.0],
-                        [0.0, 1e-5, 0.0, 0.0, 2e-6],
-                    ],
-                    "C": [0.0, 1.0, 0.0],
-                    "D": [0.0, 0.0, 0.0, 0.0, 0.0],
-                    "dt": 900.0,
-                    "state_names": ["wall", "air", "int"],
-                    "input_names": ["t_out", "ghi", "q_hvac", "q_occ", "q_light"],
-                    "input_units": ["°C", "W/m²", "W", "W", "W"],
-                    "output": "t_in",
-                    "state": {
-                        "time": "2017-01-31T00:00:00+01:00",
-                        "x": [12.1, 20.6, 20.1],
-                        "std": [0.4, 0.09, 0.3],
-                        "t_in": 20.6,
-                    },
-                    "parameter_set": SET_REF_EXAMPLE,
-                }
-            ]
+    model_config = with_examples(
+        {
+            "A": [[0.98, 0.01, 0.0], [0.02, 0.95, 0.03], [0.0, 0.04, 0.96]],
+            "B": [
+                [0.01, 1e-5, 0.0, 0.0, 0.0],
+                [0.0, 0.0, 1.7e-4, 1.7e-4, 0.0],
+                [0.0, 1e-5, 0.0, 0.0, 2e-6],
+            ],
+            "C": [0.0, 1.0, 0.0],
+            "D": [0.0, 0.0, 0.0, 0.0, 0.0],
+            "dt": 900.0,
+            "state_names": ["wall", "air", "int"],
+            "input_names": ["t_out", "ghi", "q_hvac", "q_occ", "q_light"],
+            "input_units": ["°C", "W/m²", "W", "W", "W"],
+            "output": "t_in",
+            "state": {
+                "time": "2017-01-31T00:00:00+01:00",
+                "x": [12.1, 20.6, 20.1],
+                "std": [0.4, 0.09, 0.3],
+                "t_in": 20.6,
+            },
+            "parameter_set": SET_REF_EXAMPLE,
         }
     )
 

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, create_model
+from pydantic import BaseModel, Field, create_model
 
 from rcengine.columns import COLUMNS, TIME
+
+from .common import LocalTime, with_examples
 
 EXAMPLE_ROWS = [
     {
@@ -76,32 +78,29 @@ def upload_openapi() -> dict[str, Any]:
 class UploadResult(BaseModel):
     """Counts of an accepted upload (a rejected one stores nothing and answers 422)."""
 
-    model_config = ConfigDict(
-        json_schema_extra={
-            "examples": [
-                {
-                    "inserted": 96,
-                    "updated": 4,
-                    "rejected": 0,
-                    "rows": 100,
-                    "first_time": "2017-01-09T00:00:00+01:00",
-                    "last_time": "2017-01-10T00:45:00+01:00",
-                    "data_revision": 5,
-                }
-            ]
-        }
+    model_config = with_examples(
+        {
+            "inserted": 96,
+            "updated": 4,
+            "rejected": 0,
+            "rows": 100,
+            "first_time": "2017-01-09T00:00:00+01:00",
+            "last_time": "2017-01-10T00:45:00+01:00",
+            "data_revision": 5,
+        },
+        from_attributes=True,
     )
 
     inserted: int
     updated: int = Field(description="Rows whose time was already stored")
     rejected: int = Field(0, description="Always 0: an upload is accepted or rejected whole")
     rows: int
-    first_time: str
-    last_time: str
+    first_time: LocalTime
+    last_time: LocalTime
     data_revision: int
 
 
 class MeasurementsRead(BaseModel):
-    model_config = ConfigDict(json_schema_extra={"examples": [{"rows": EXAMPLE_ROWS}]})
+    model_config = with_examples({"rows": EXAMPLE_ROWS})
 
     rows: list[dict[str, Any]]

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
+
+from .common import LocalTime, with_examples
 
 SET_EXAMPLE = {
     "id": 4,
@@ -43,7 +45,7 @@ class ParameterValue(BaseModel):
 class ParameterSetRead(BaseModel):
     """status: current | superseded (was current) | rejected (worse on its held-out day)."""
 
-    model_config = ConfigDict(json_schema_extra={"examples": [SET_EXAMPLE]})
+    model_config = with_examples(SET_EXAMPLE, from_attributes=True)
 
     id: int
     model: str
@@ -51,9 +53,9 @@ class ParameterSetRead(BaseModel):
     is_current: bool
     reason: str | None = Field(description="Why a rejected set was not promoted")
     job_id: int | None
-    created_at: str
-    train_start: str
-    train_end: str
+    created_at: LocalTime
+    train_start: LocalTime
+    train_end: LocalTime
     rmse_train: float | None = Field(description="[K]")
     rmse_holdout: float | None = Field(description="Day-ahead forecast of the held-out day [K]")
     metrics: dict[str, Any] = Field(description="RMSE, MBE, CV(RMSE), NMBE, ASHRAE 14 verdict")
@@ -62,9 +64,7 @@ class ParameterSetRead(BaseModel):
 
 
 class ParameterSetList(BaseModel):
-    model_config = ConfigDict(
-        json_schema_extra={"examples": [{"current_id": 4, "items": [SET_EXAMPLE]}]}
-    )
+    model_config = with_examples({"current_id": 4, "items": [SET_EXAMPLE]})
 
     current_id: int | None
     items: list[ParameterSetRead]

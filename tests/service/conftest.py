@@ -89,12 +89,37 @@ def wait_for_job(client: TestClient | httpx.Client, job_id: int, headers: dict, 
 
 
 # --- data -------------------------------------------------------------------------------------
+# Rows of one day at 15 min.
+DAY = 96
+
+
 @pytest.fixture(scope="session")
 def synthetic() -> pd.DataFrame:
     """Four days at 15 min with t_in from the hand-written 3R3C reference (tests/synthetic.py)."""
     frame = weather_and_gains(days=4, seed=5)
     frame["t_in"] = basic_reference(frame, TRUTH_BASIC, x0=(8.0, 19.0, 18.5))
     return frame[["t_in", "t_out", "ghi", "q_hvac", "q_occ", "q_light"]]
+
+
+@pytest.fixture(scope="session")
+def three_days_measured(synthetic) -> pd.DataFrame:
+    """The synthetic days with t_in measured on days 1–3; day 4 holds future inputs only."""
+    frame = synthetic.copy()
+    frame.iloc[3 * DAY :, frame.columns.get_loc("t_in")] = np.nan
+    return frame
+
+
+@pytest.fixture
+def measured(client, three_days_measured) -> tuple[int, dict]:
+    """A registered building with ``three_days_measured`` uploaded: its id and headers."""
+    building_id, headers = register(client)
+    response = client.post(
+        f"/buildings/{building_id}/measurements",
+        json={"rows": json_rows(three_days_measured)},
+        headers=headers,
+    )
+    assert response.status_code == 200, response.text
+    return building_id, headers
 
 
 @pytest.fixture(scope="session")

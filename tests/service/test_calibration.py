@@ -11,7 +11,6 @@ from concurrent.futures import Future
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 
-import numpy as np
 import pandas as pd
 import pytest
 from fastapi.testclient import TestClient
@@ -20,21 +19,7 @@ from service import calibration, repository
 from service.core.db import Database
 from service.main import create_app
 
-from .conftest import json_rows, register, wait_for_job
-
-DAY = 96
-
-
-@pytest.fixture
-def measured(client, synthetic):
-    building_id, headers = register(client)
-    frame = synthetic.copy()
-    frame.iloc[3 * DAY :, frame.columns.get_loc("t_in")] = np.nan
-    response = client.post(
-        f"/buildings/{building_id}/measurements", json={"rows": json_rows(frame)}, headers=headers
-    )
-    assert response.status_code == 200
-    return building_id, headers
+from .conftest import DAY, json_rows, register, wait_for_job
 
 
 def calibrate(client, building_id, headers, days=1):
@@ -76,6 +61,47 @@ def test_first_calibration_fits_before_and_scores_on_the_held_out_day(client, me
     # The data come from the model's own structure: fit and day-ahead forecast are near exact.
     assert only["rmse_train"] < 0.01 and only["rmse_holdout"] < 0.01
     assert only["metrics"]["holdout"]["n"] == DAY
+
+
+def in_zone(value: str, timezone: str) -> bool:
+    """True for ISO 8601 text with the UTC offset ``timezone`` has at that instant."""
+    stamp = pd.Timestamp(value)
+    return stamp.tzinfo is not None and stamp.utcoffset() == stamp.tz_convert(timezone).utcoffset()
+
+
+def test_every_time_in_the_answers_is_in_the_buildings_zone(client, measured):
+    """docs/service.md: times in answers carry the offset of the building's time zone."""
+    building_id, headers = measured
+    job = calibrate(client, building_id, headers)
+    base = f"/buildings/{building_id}"
+    building = client.get(base, headers=headers).json()
+    set_id = building["current_parameter_set_id"]
+    answers = {
+        "job": (job, ("created_at", "started_at", "finished_at")),
+        "jobs": (
+            client.get(f"{base}/calibrations", headers=headers).json()["items"][0],
+            ("created_at", "started_at", "finished_at"),
+        ),
+        "building": (building, ("created_at", "first_time", "last_time", "last_measured_time")),
+        "set": (
+            client.get(f"{base}/parameters/{set_id}", headers=headers).json(),
+            ("created_at", "train_start", "train_end"),
+        ),
+        "forecast set": (
+            client.get(f"{base}/forecast", params={"hours": 1}, headers=headers).json()[
+                "parameter_set"
+            ],
+            ("created_at", "train_start", "train_end"),
+        ),
+        "state": (client.get(f"{base}/model", headers=headers).json()["state"], ("time",)),
+    }
+    timezone = building["timezone"]
+    assert timezone != "UTC"
+    for name, (answer, keys) in answers.items():
+        for key in keys:
+            assert in_zone(answer[key], timezone), (name, key, answer[key])
+    assert building["last_measured_time"] == "2017-01-12T00:45:00+01:00"
+    assert job["created_at"] == answers["jobs"][0]["created_at"]
 
 
 def test_failed_fit_keeps_the_current_set(client, measured, synthetic, monkeypatch):

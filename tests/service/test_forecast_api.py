@@ -9,20 +9,13 @@ import pytest
 from rcengine.forecast import forecast
 from rcengine.parameter_set import ParameterSet
 
-from .conftest import json_rows, register, rmse, wait_for_job
-
-DAY = 96
+from .conftest import DAY, json_rows, register, rmse, wait_for_job
 
 
 @pytest.fixture
-def calibrated(client, synthetic):
+def calibrated(client, measured):
     """Days 1–3 measured, day 4 future inputs only, a current set fitted on day 2."""
-    building_id, headers = register(client)
-    frame = synthetic.copy()
-    frame.iloc[3 * DAY :, frame.columns.get_loc("t_in")] = np.nan
-    client.post(
-        f"/buildings/{building_id}/measurements", json={"rows": json_rows(frame)}, headers=headers
-    )
+    building_id, headers = measured
     job = client.post(f"/buildings/{building_id}/calibrations", json={"days": 1}, headers=headers)
     assert wait_for_job(client, job.json()["id"], headers)["outcome"] == "promoted"
     return building_id, headers
@@ -32,7 +25,9 @@ def get_forecast(client, building_id, headers, **params):
     return client.get(f"/buildings/{building_id}/forecast", params=params, headers=headers)
 
 
-def test_forecast_matches_the_engine_and_the_truth(client, calibrated, synthetic):
+def test_forecast_matches_the_engine_and_the_truth(
+    client, calibrated, synthetic, three_days_measured
+):
     building_id, headers = calibrated
     start = synthetic.index[3 * DAY]
     response = get_forecast(client, building_id, headers, start="2017-01-12T01:00:00+01:00")
@@ -41,9 +36,8 @@ def test_forecast_matches_the_engine_and_the_truth(client, calibrated, synthetic
     set_id = body["parameter_set"]["id"]
     document = client.get(f"/buildings/{building_id}/parameters/{set_id}/document", headers=headers)
     pset = ParameterSet.from_dict(document.json())
-    frame = synthetic.copy()
-    frame.iloc[3 * DAY :, frame.columns.get_loc("t_in")] = np.nan
-    expected = forecast(pset.compiled, pset.values, pset.prepare(frame), start, hours=24)
+    data = pset.prepare(three_days_measured)
+    expected = forecast(pset.compiled, pset.values, data, start, hours=24)
     np.testing.assert_allclose(body["t_in_pred"], expected.t_in_pred, rtol=0, atol=1e-9)
     assert rmse(body["t_in_pred"], synthetic["t_in"].iloc[3 * DAY :]) < 0.01
     assert body["times"][0] == "2017-01-12T01:00:00+01:00"

@@ -185,6 +185,8 @@ def test_invalid_settings_fail_at_start():
         Settings(timezone="Mars/Base")
     with pytest.raises(ValueError, match="invalid preset"):
         Settings(preset="fastest")
+    with pytest.raises(ValueError, match="invalid preset"):
+        Settings(diagnosis_preset="fastest")
 
 
 def test_schema_and_upsert_compile_for_postgresql():

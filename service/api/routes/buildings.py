@@ -5,14 +5,11 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, Path, status
-from sqlalchemy.orm import Session
 
 from rcengine.building import Building
 
 from ... import repository
-from ...bridge import local_time
 from ...core.security import hash_token, new_token
-from ...models import BuildingRecord
 from ...schemas.buildings import (
     BuildingCreate,
     BuildingCreated,
@@ -20,7 +17,7 @@ from ...schemas.buildings import (
     BuildingRead,
     TokenRotated,
 )
-from ...schemas.common import error_responses
+from ...schemas.common import error_responses, in_zone
 from ..deps import AdminDep, BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["buildings"])
@@ -44,11 +41,9 @@ def create_building(body: BuildingCreate, ctx: ContextDep, _: AdminDep) -> Build
             building.location.timezone,
             hash_token(token),
         )
-    return BuildingCreated(
-        id=record.id,
-        name=record.name,
-        token=token,
-        created_at=local_time(record.created_at, record.timezone),
+    return BuildingCreated.model_validate(
+        {"id": record.id, "name": record.name, "token": token, "created_at": record.created_at},
+        context=in_zone(record.timezone),
     )
 
 
@@ -60,7 +55,10 @@ def create_building(body: BuildingCreate, ctx: ContextDep, _: AdminDep) -> Build
 )
 def list_buildings(ctx: ContextDep, _: AdminDep) -> BuildingList:
     with ctx.db.session() as session:
-        return BuildingList(items=[_read(session, b) for b in repository.list_buildings(session)])
+        rows = repository.building_summaries(session)
+    return BuildingList(
+        items=[BuildingRead.model_validate(row, context=in_zone(row.timezone)) for row in rows]
+    )
 
 
 @router.get(
@@ -71,7 +69,8 @@ def list_buildings(ctx: ContextDep, _: AdminDep) -> BuildingList:
 )
 def read_building(building_id: BuildingDep, ctx: ContextDep) -> BuildingRead:
     with ctx.db.session() as session:
-        return _read(session, repository.get_building(session, building_id))
+        row = repository.building_summary(session, building_id)
+    return BuildingRead.model_validate(row, context=in_zone(row.timezone))
 
 
 @router.post(
@@ -90,23 +89,3 @@ def rotate_token(
         repository.set_token_hash(session, building_id, hash_token(token))
     ctx.tokens.forget(building_id)
     return TokenRotated(id=building_id, token=token)
-
-
-def _read(session: Session, record: BuildingRecord) -> BuildingRead:
-    rows, first, last = repository.measurement_summary(session, record.id)
-    current = repository.current_parameter_set(session, record.id)
-    tz = record.timezone
-    return BuildingRead(
-        id=record.id,
-        name=record.name,
-        timezone=tz,
-        description=record.description,
-        created_at=local_time(record.created_at, tz),
-        step_s=record.step_s,
-        rows=rows,
-        first_time=local_time(first, tz),
-        last_time=local_time(last, tz),
-        last_measured_time=local_time(record.last_measured_at, tz),
-        data_revision=record.data_revision,
-        current_parameter_set_id=None if current is None else current.id,
-    )

@@ -1,4 +1,4 @@
-"""Calibration jobs: start one (202), list a building's (poll one at ``/jobs/{job_id}``)."""
+"""Calibration jobs: start one (202); ``routes/jobs`` polls it and lists a building's."""
 
 from __future__ import annotations
 
@@ -6,11 +6,11 @@ from typing import Annotated
 
 from fastapi import APIRouter, Body, Response, status
 
-from ...models import CALIBRATION
-from ...schemas.calibrations import CalibrationRequest, JobList, JobRead
+from ...schemas.calibrations import CalibrationRequest
 from ...schemas.common import error_responses
+from ...schemas.jobs import JobRead
+from ..answers import queued
 from ..deps import BuildingDep, ContextDep
-from .jobs import building_jobs, queued
 
 router = APIRouter(tags=["calibrations"])
 
@@ -36,15 +36,5 @@ def start_calibration(
 ) -> JobRead:
     body = body or CalibrationRequest()
     model, days = body.model or ctx.settings.model, body.days or ctx.settings.training_days
-    job = ctx.runner.create(building_id, model, days, "api")
+    job = ctx.runner.create_calibration(building_id, model, days, "api")
     return queued(ctx, job, response)
-
-
-@router.get(
-    "/buildings/{building_id}/calibrations",
-    response_model=JobList,
-    summary="The building's calibration jobs, newest first",
-    responses=error_responses(401, 404),
-)
-def list_calibrations(building_id: BuildingDep, ctx: ContextDep) -> JobList:
-    return JobList(items=building_jobs(ctx, building_id, CALIBRATION))

@@ -1,5 +1,5 @@
-"""Mismatch diagnoses: start one (202), list a building's jobs, read the latest report as JSON
-or as its HTML page."""
+"""Mismatch diagnoses: start one (202; ``routes/jobs`` polls it and lists a building's), read
+the latest report as JSON or as its HTML page."""
 
 from __future__ import annotations
 
@@ -8,17 +8,20 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, Body, Header, HTTPException, Query, Response, status
 from fastapi.responses import HTMLResponse
 
+from rcengine.io.instants import parse_instant
+
 from ... import repository
-from ...bridge import local_time, parse_instant
 from ...diagnosis import DiagnosisSpec
-from ...models import DIAGNOSIS, DiagnosisRecord, JobRecord
-from ...schemas.calibrations import JobList, JobRead
+from ...models import DIAGNOSIS, JobRecord
 from ...schemas.common import error_responses
 from ...schemas.diagnoses import DIAGNOSIS_EXAMPLE, DiagnosisRead, DiagnosisRequest
+from ...schemas.jobs import JobRead
+from ..answers import building_zone, queued
 from ..deps import BuildingDep, ContextDep
-from .jobs import building_jobs, queued
 
 router = APIRouter(prefix="/buildings", tags=["diagnoses"])
+# Columns of a stored diagnosis answered as they are.
+SERVICE_FIELDS = ("id", "building_id", "job_id", "created_at", "settings", "engine_version")
 
 
 @router.post(
@@ -53,16 +56,6 @@ def start_diagnosis(
     )
     job = ctx.runner.create_diagnosis(building_id, body.model or ctx.settings.model, spec, "api")
     return queued(ctx, job, response)
-
-
-@router.get(
-    "/{building_id}/diagnoses",
-    response_model=JobList,
-    summary="The building's diagnosis jobs, newest first",
-    responses=error_responses(401, 404),
-)
-def list_diagnoses(building_id: BuildingDep, ctx: ContextDep) -> JobList:
-    return JobList(items=building_jobs(ctx, building_id, DIAGNOSIS))
 
 
 @router.get(
@@ -113,8 +106,20 @@ def read_diagnosis(
             raise HTTPException(status.HTTP_404_NOT_FOUND, _none_yet(building_id, active))
         if as_html:
             return HTMLResponse(record.html)
-        tz = repository.get_building(session, building_id).timezone
-        return _read(record, tz)
+        context = building_zone(session, building_id)
+    # The engine's report at the top level, beside what the service adds.
+    return DiagnosisRead.model_validate(
+        {
+            **record.report,
+            **{name: getattr(record, name) for name in SERVICE_FIELDS},
+            "window": {
+                "start": record.window_start,
+                "end": record.window_end,
+                "train_fraction": record.settings["train_fraction"],
+            },
+        },
+        context=context,
+    )
 
 
 def _none_yet(building_id: int, active: JobRecord | None) -> str:
@@ -122,22 +127,3 @@ def _none_yet(building_id: int, active: JobRecord | None) -> str:
     if active is None:
         return f"{message}; start one with POST /buildings/{building_id}/diagnoses"
     return f"{message}; diagnosis job {active.id} is {active.status}: poll GET /jobs/{active.id}"
-
-
-def _read(record: DiagnosisRecord, tz: str) -> DiagnosisRead:
-    return DiagnosisRead.model_validate(
-        {
-            **record.report,
-            "id": record.id,
-            "building_id": record.building_id,
-            "job_id": record.job_id,
-            "created_at": local_time(record.created_at, tz),
-            "window": {
-                "start": local_time(record.window_start, tz),
-                "end": local_time(record.window_end, tz),
-                "train_fraction": record.settings["train_fraction"],
-            },
-            "settings": record.settings,
-            "engine_version": record.engine_version,
-        }
-    )

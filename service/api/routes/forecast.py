@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Annotated
+from typing import Annotated, TypeVar
 
 import numpy as np
 from fastapi import APIRouter, HTTPException, Query, status
 from fastapi.concurrency import run_in_threadpool
 
 from rcengine.columns import COLUMNS
+from rcengine.io.instants import parse_instant
 
-from ...bridge import local_time, parse_instant
-from ...forecasting import SetInfo
-from ...schemas.common import error_responses
+from ...forecasting import Prediction, SetInfo
+from ...schemas.common import error_responses, in_zone
 from ...schemas.forecast import (
     MAX_CANDIDATES,
     MAX_HORIZON_H,
@@ -22,11 +22,11 @@ from ...schemas.forecast import (
     ParameterSetRef,
     SimulateRead,
     SimulateRequest,
-    StateEstimate,
 )
 from ..deps import BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["forecast"])
+Trajectories = TypeVar("Trajectories", ForecastRead, SimulateRead)
 
 StartQuery = Annotated[
     str | None,
@@ -63,12 +63,7 @@ async def forecast(
     prediction = ctx.forecaster.cached(building_id, first, hours)
     if prediction is None:
         prediction = await run_in_threadpool(ctx.forecaster.forecast, building_id, first, hours)
-    return ForecastRead(
-        times=prediction.local_times,
-        t_in_pred=prediction.t_in_pred.tolist(),
-        parameter_set=_ref(prediction.parameter_set, prediction.timezone),
-        step_s=prediction.model.dt,
-    )
+    return _trajectories(ForecastRead, prediction, t_in_pred=prediction.t_in_pred.tolist())
 
 
 @router.post(
@@ -93,12 +88,7 @@ def simulate(building_id: BuildingDep, body: SimulateRequest, ctx: ContextDep) -
         raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, "q_hvac must be finite")
     first = None if body.start is None else parse_instant(body.start, "start")
     prediction, outputs = ctx.forecaster.simulate(building_id, first, candidates)
-    return SimulateRead(
-        times=prediction.local_times,
-        t_in=outputs.tolist(),
-        parameter_set=_ref(prediction.parameter_set, prediction.timezone),
-        step_s=prediction.model.dt,
-    )
+    return _trajectories(SimulateRead, prediction, t_in=outputs.tolist())
 
 
 @router.get(
@@ -127,22 +117,35 @@ def model(
     when = None if at is None else parse_instant(at, "at")
     result = ctx.forecaster.model_state(building_id, when)
     m = result.model
-    return ModelRead(
-        A=m.A.tolist(),
-        B=m.B.tolist(),
-        C=m.C.tolist(),
-        D=m.D.tolist(),
-        dt=m.dt,
-        state_names=list(m.state_names),
-        input_names=list(m.input_names),
-        input_units=[COLUMNS[n].unit if n in COLUMNS else None for n in m.input_names],
-        state=StateEstimate(
-            time=result.local_at,
-            x=result.state.tolist(),
-            std=np.sqrt(np.clip(np.diag(result.covariance), 0.0, None)).tolist(),
-            t_in=float(m.C @ result.state),
-        ),
-        parameter_set=_ref(result.parameter_set, result.timezone),
+    return ModelRead.model_validate(
+        {
+            "A": m.A.tolist(),
+            "B": m.B.tolist(),
+            "C": m.C.tolist(),
+            "D": m.D.tolist(),
+            "dt": m.dt,
+            "state_names": list(m.state_names),
+            "input_names": list(m.input_names),
+            "input_units": [COLUMNS[n].unit if n in COLUMNS else None for n in m.input_names],
+            "state": {
+                "time": result.at,
+                "x": result.state.tolist(),
+                "std": np.sqrt(np.clip(np.diag(result.covariance), 0.0, None)).tolist(),
+                "t_in": float(m.C @ result.state),
+            },
+            "parameter_set": result.parameter_set,
+        },
+        context=in_zone(result.timezone),
+    )
+
+
+def _trajectories(schema: type[Trajectories], prediction: Prediction, **t_in: list) -> Trajectories:
+    """Indoor temperature ``t_in`` over the prediction's times, with the set it came from."""
+    return schema(
+        times=prediction.local_times,
+        parameter_set=_ref(prediction.parameter_set, prediction.timezone),
+        step_s=prediction.model.dt,
+        **t_in,
     )
 
 
@@ -150,13 +153,4 @@ def model(
 def _ref(info: SetInfo, tz: str) -> ParameterSetRef:
     """The set's summary with local times (cached: formatting times costs more than a forecast
     served from the cache)."""
-    return ParameterSetRef(
-        id=info.id,
-        model=info.model,
-        created_at=local_time(info.created_at, tz),
-        train_start=local_time(info.train_start, tz),
-        train_end=local_time(info.train_end, tz),
-        rmse_train=info.rmse_train,
-        rmse_holdout=info.rmse_holdout,
-        engine_version=info.engine_version,
-    )
+    return ParameterSetRef.model_validate(info, context=in_zone(tz))

@@ -1,19 +1,22 @@
-"""Jobs of every kind (calibrations, diagnoses): poll one; the record as its answer."""
+"""Jobs of every kind (calibrations, diagnoses): poll one; list a building's jobs of a kind."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Annotated
 
-from fastapi import APIRouter, HTTPException, Path, Response, status
+from fastapi import APIRouter, HTTPException, Path, status
 
 from ... import repository
-from ...bridge import local_time
-from ...models import JobRecord
-from ...schemas.calibrations import JobRead
+from ...models import CALIBRATION, DIAGNOSIS
 from ...schemas.common import error_responses
-from ..deps import ContextDep, TokenBuildingDep
+from ...schemas.jobs import JobList, JobRead
+from ..answers import building_zone, job_read
+from ..deps import BuildingDep, ContextDep, TokenBuildingDep
 
-router = APIRouter(tags=["jobs"])
+router = APIRouter()
+# Jobs listed per building and kind, newest first.
+JOBS_LISTED = 100
 
 
 @router.get(
@@ -21,6 +24,7 @@ router = APIRouter(tags=["jobs"])
     response_model=JobRead,
     summary="A calibration or diagnosis job: queued | running | succeeded | failed",
     responses=error_responses(401, 404),
+    tags=["jobs"],
 )
 def read_job(
     job_id: Annotated[int, Path(examples=[12])], ctx: ContextDep, owner: TokenBuildingDep
@@ -29,40 +33,29 @@ def read_job(
         job = repository.get_job(session, job_id)
         if owner is not None and job.building_id != owner:
             raise HTTPException(status.HTTP_404_NOT_FOUND, f"job {job_id} not found")
-        return job_read(job, repository.get_building(session, job.building_id).timezone)
+        return job_read(session, job)
 
 
-def queued(ctx: ContextDep, job: JobRecord, response: Response) -> JobRead:
-    """The answer to a call that queued ``job``: the job, and where to poll it (Location)."""
-    response.headers["Location"] = f"/jobs/{job.id}"
-    with ctx.db.session() as session:
-        return job_read(job, repository.get_building(session, job.building_id).timezone)
+def _jobs_of(kind: str) -> Callable[..., JobList]:
+    def list_jobs(building_id: BuildingDep, ctx: ContextDep) -> JobList:
+        with ctx.db.session() as session:
+            jobs = repository.list_jobs(session, building_id, JOBS_LISTED, kind)
+            return JobList.model_validate(
+                {"items": jobs}, context=building_zone(session, building_id)
+            )
+
+    return list_jobs
 
 
-def building_jobs(ctx: ContextDep, building_id: int, kind: str) -> list[JobRead]:
-    """The building's last 100 jobs of ``kind``, newest first."""
-    with ctx.db.session() as session:
-        tz = repository.get_building(session, building_id).timezone
-        return [job_read(j, tz) for j in repository.list_jobs(session, building_id, 100, kind)]
-
-
-def job_read(job: JobRecord, tz: str) -> JobRead:
-    details = job.details or {}
-    return JobRead(
-        id=job.id,
-        building_id=job.building_id,
-        kind=job.kind,
-        status=job.status,
-        outcome=job.outcome,
-        trigger=job.trigger,
-        model=job.model,
-        days=job.days,
-        created_at=local_time(job.created_at, tz),
-        started_at=local_time(job.started_at, tz),
-        finished_at=local_time(job.finished_at, tz),
-        error=job.error,
-        parameter_set_id=details.get("parameter_set_id"),
-        diagnosis_id=details.get("diagnosis_id"),
-        options=job.options,
-        details=job.details,
+# GET /buildings/{id}/calibrations and /buildings/{id}/diagnoses, beside the POST that starts one.
+for kind, resource in ((CALIBRATION, "calibrations"), (DIAGNOSIS, "diagnoses")):
+    router.add_api_route(
+        f"/buildings/{{building_id}}/{resource}",
+        _jobs_of(kind),
+        methods=["GET"],
+        response_model=JobList,
+        summary=f"The building's {kind} jobs, newest first",
+        responses=error_responses(401, 404),
+        tags=[resource],
+        name=f"list_{resource}",
     )

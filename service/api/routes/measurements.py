@@ -11,11 +11,12 @@ from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
 from rcengine.columns import TIME
+from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import format_times, write_timeseries
 
 from ... import bridge, ingest, repository
 from ...context import ServiceContext
-from ...schemas.common import error_responses
+from ...schemas.common import error_responses, in_zone
 from ...schemas.measurements import (
     EXAMPLE_CSV,
     MeasurementsRead,
@@ -60,14 +61,7 @@ async def upload(building_id: BuildingDep, request: Request, ctx: ContextDep) ->
         )
     body = await request.body()
     result, tz = await run_in_threadpool(_parse_and_store, ctx, building_id, parse, body)
-    return UploadResult(
-        inserted=result.inserted,
-        updated=result.updated,
-        rows=result.rows,
-        first_time=bridge.local_time(result.first_time, tz),
-        last_time=bridge.local_time(result.last_time, tz),
-        data_revision=result.data_revision,
-    )
+    return UploadResult.model_validate(result, context=in_zone(tz))
 
 
 def _parse_and_store(
@@ -97,8 +91,8 @@ def read_measurements(
         str, Query(alias="format", pattern="^(json|csv)$", examples=["json"])
     ] = "json",
 ):
-    first = None if start is None else bridge.parse_instant(start, "start")
-    last = None if end is None else bridge.parse_instant(end, "end")
+    first = None if start is None else parse_instant(start, "start")
+    last = None if end is None else parse_instant(end, "end")
     with ctx.db.session() as session:
         tz = repository.get_building(session, building_id).timezone
         frame = bridge.load_frame(session, building_id, first, last)

@@ -7,10 +7,9 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Path
 
 from ... import repository
-from ...bridge import local_time
-from ...models import ParameterSetRecord
 from ...schemas.common import error_responses
-from ...schemas.parameters import ParameterSetList, ParameterSetRead, ParameterValue
+from ...schemas.parameters import ParameterSetList, ParameterSetRead
+from ..answers import building_zone
 from ..deps import BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["parameters"])
@@ -25,10 +24,12 @@ SetId = Annotated[int, Path(description="Parameter-set id", examples=[4])]
 )
 def list_parameter_sets(building_id: BuildingDep, ctx: ContextDep) -> ParameterSetList:
     with ctx.db.session() as session:
-        tz = repository.get_building(session, building_id).timezone
-        items = [_read(r, tz) for r in repository.list_parameter_sets(session, building_id)]
-    current = next((item.id for item in items if item.is_current), None)
-    return ParameterSetList(current_id=current, items=items)
+        context = building_zone(session, building_id)
+        records = repository.list_parameter_sets(session, building_id)
+    current = next((record.id for record in records if record.is_current), None)
+    return ParameterSetList.model_validate(
+        {"current_id": current, "items": records}, context=context
+    )
 
 
 @router.get(
@@ -41,8 +42,8 @@ def read_parameter_set(
     building_id: BuildingDep, set_id: SetId, ctx: ContextDep
 ) -> ParameterSetRead:
     with ctx.db.session() as session:
-        tz = repository.get_building(session, building_id).timezone
-        return _read(repository.get_parameter_set(session, building_id, set_id), tz)
+        record = repository.get_parameter_set(session, building_id, set_id)
+        return ParameterSetRead.model_validate(record, context=building_zone(session, building_id))
 
 
 @router.get(
@@ -60,22 +61,3 @@ def parameter_set_document(
 ) -> dict[str, Any]:
     with ctx.db.session() as session:
         return repository.get_parameter_set(session, building_id, set_id).document
-
-
-def _read(record: ParameterSetRecord, tz: str) -> ParameterSetRead:
-    return ParameterSetRead(
-        id=record.id,
-        model=record.model,
-        status=record.status,
-        is_current=record.is_current,
-        reason=record.reason,
-        job_id=record.job_id,
-        created_at=local_time(record.created_at, tz),
-        train_start=local_time(record.train_start, tz),
-        train_end=local_time(record.train_end, tz),
-        rmse_train=record.rmse_train,
-        rmse_holdout=record.rmse_holdout,
-        metrics=record.metrics,
-        engine_version=record.engine_version,
-        parameters={name: ParameterValue(**p) for name, p in record.document["parameters"].items()},
-    )

@@ -1,0 +1,43 @@
+"""What the diagnosis benchmarks share: diagnose one committed case folder and read its answer.
+
+A case folder holds ``data.csv`` (CONTRACT.md §1) and ``building.json`` (§2), as
+``data/energyplus/variants/<case>/`` and ``data/testbed/<case>/`` do.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+from rcengine.building import Building
+from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose.html import save_figures
+from rcengine.io.timeseries import read_timeseries
+
+
+def accepted_effects(report: dict) -> list[str]:
+    """The accepted findings in the report's order; the first is the tool's answer."""
+    return [f["effect"] for f in report["findings"] if f["accepted"]]
+
+
+def diagnose_folder(
+    folder: Path,
+    model: str,
+    out: Path | None = None,
+    figures: bool = True,
+    settings: DiagnoseSettings | None = None,
+) -> tuple[dict, float]:
+    """Diagnose the case in ``folder`` with ``model``: its report as JSON data and the wall time
+    of the diagnosis [s]. With ``out``, ``<case>.json`` (and its figures) are written there."""
+    name = folder.name
+    building = Building.from_json(folder / "building.json")
+    frame = read_timeseries(folder / "data.csv")
+    started = time.perf_counter()
+    report = diagnose(frame, building, model, settings)
+    wall = time.perf_counter() - started
+    if out is not None:
+        (out / f"{name}.json").write_text(report.to_json() + "\n")
+        if figures:
+            save_figures(report, out, name)
+    return json.loads(report.to_json()), wall

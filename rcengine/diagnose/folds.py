@@ -1,0 +1,192 @@
+"""Evidence that survives the season: rolling folds across the record and the rule that judges an
+extension on all of them.
+
+One split in the middle of a heating season confounds any missing physics with the change from
+low to high sun, from cold to mild: a candidate that happens to track the season wins the test
+half. Rolling-origin evaluation (Tashman 2000, "Out-of-sample tests of forecasting accuracy")
+fits on a few weeks and scores on the next two, at several origins spread over the record; an
+effect of physics helps in most of them, a seasonal coincidence in few.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.stats import binom
+
+
+@dataclass(frozen=True)
+class Fold:
+    """One origin: fit on [train_start, test_start), score on [test_start, test_end). UTC."""
+
+    index: int
+    train_start: pd.Timestamp
+    test_start: pd.Timestamp
+    test_end: pd.Timestamp
+
+    def label(self, timezone: str) -> str:
+        """``"2017-01-09…2017-01-22"``: the test window's local dates."""
+        last = (self.test_end - pd.Timedelta(seconds=1)).tz_convert(timezone)
+        return f"{self.test_start.tz_convert(timezone).date()}…{last.date()}"
+
+
+def rolling_folds(
+    times: pd.DatetimeIndex,
+    timezone: str,
+    train_days: int = 28,
+    test_days: int = 14,
+    max_folds: int = 6,
+) -> list[Fold]:
+    """Up to ``max_folds`` origins spread evenly over the record, on local midnights.
+
+    Each fold trains on ``train_days`` whole local days and tests on the next ``test_days``;
+    origins are spaced evenly between the first possible and the last, so the folds cover the
+    season from its start to its end (they overlap when the record is short). A record too short
+    for one fold gives none.
+
+    Parameters
+    ----------
+    times : DatetimeIndex
+        The record's times (tz-aware).
+    timezone : str
+        The building's IANA zone; days start at its local midnight.
+    """
+    if train_days < 1 or test_days < 1 or max_folds < 1:
+        raise ValueError("train_days, test_days and max_folds must be at least 1")
+    local = times.tz_convert(timezone)
+    first = local[0].normalize()
+    if local[0] > first:
+        first += pd.Timedelta(days=1)
+    last = local[-1].normalize()  # the record's last complete local day ends here
+    n_days = (last.tz_localize(None) - first.tz_localize(None)).days
+    span = train_days + test_days
+    if n_days < span:
+        return []
+    n_origins = n_days - span + 1
+    n = min(max_folds, n_origins)
+    offsets = np.unique(np.round(np.linspace(0, n_origins - 1, n)).astype(int))
+    return [
+        Fold(
+            k,
+            _local_midnight(first, int(o)),
+            _local_midnight(first, int(o) + train_days),
+            _local_midnight(first, int(o) + span),
+        )
+        for k, o in enumerate(offsets)
+    ]
+
+
+def _local_midnight(first: pd.Timestamp, days: int) -> pd.Timestamp:
+    # Calendar days, not 24-h steps: a fold that spans a daylight-saving change still starts
+    # and ends at local midnight.
+    naive = first.tz_localize(None) + pd.Timedelta(days=days)
+    return naive.tz_localize(first.tz, ambiguous=False, nonexistent="shift_forward").tz_convert(
+        "UTC"
+    )
+
+
+@dataclass(frozen=True)
+class FoldEvidence:
+    """Test errors of the current model (``before``) and of an extension (``after``) on every
+    fold. Each entry is that fold's test residual (measured − simulated) [K]."""
+
+    before: tuple[np.ndarray, ...]
+    after: tuple[np.ndarray, ...]
+
+    @property
+    def rmse_before(self) -> np.ndarray:
+        return np.array([_rmse(r) for r in self.before])
+
+    @property
+    def rmse_after(self) -> np.ndarray:
+        return np.array([_rmse(r) for r in self.after])
+
+    @property
+    def pooled_before(self) -> float:
+        """RMSE over every fold's test rows together. [K]"""
+        return _rmse(np.concatenate(self.before))
+
+    @property
+    def pooled_after(self) -> float:
+        return _rmse(np.concatenate(self.after))
+
+    @property
+    def helped(self) -> np.ndarray:
+        """Per fold: did the extension lower the test RMSE?"""
+        return self.rmse_after < self.rmse_before
+
+    @property
+    def confidence(self) -> float:
+        """1 − the one-sided sign-test p-value of "helps in this many folds" under "helps or
+        hurts at random" (each fold a fair coin): how unlikely that record is by chance."""
+        n, k = len(self.before), int(self.helped.sum())
+        return float(1.0 - binom.sf(k - 1, n, 0.5)) if n else 0.0
+
+    def to_dict(self, folds: list[Fold] | None = None, timezone: str = "UTC") -> dict:
+        per_fold = [
+            {"rmse_test_before": float(b), "rmse_test_after": float(a)}
+            for b, a in zip(self.rmse_before, self.rmse_after, strict=True)
+        ]
+        if folds is not None:
+            for row, fold in zip(per_fold, folds, strict=True):
+                row["test"] = fold.label(timezone)
+        return {
+            "folds": per_fold,
+            "helped": int(self.helped.sum()),
+            "pooled_rmse_test_before": self.pooled_before,
+            "pooled_rmse_test_after": self.pooled_after,
+            "confidence": self.confidence,
+        }
+
+
+def _rmse(residual: np.ndarray) -> float:
+    r = residual[np.isfinite(residual)]
+    return float(np.sqrt(r @ r / r.size)) if r.size else float("nan")
+
+
+@dataclass(frozen=True)
+class FoldRule:
+    """min_share: share of folds the extension must help in (a strict majority by default);
+    min_improvement: relative cut of the pooled test RMSE; min_improvement_k: the same in
+    kelvin (a room sensor's accuracy: smaller gains are no evidence of physics)."""
+
+    min_share: float = 0.5
+    min_improvement: float = 0.10
+    min_improvement_k: float = 0.1
+
+
+def judge_folds(evidence: FoldEvidence, rule: FoldRule) -> tuple[bool, str]:
+    """Accept when the extension helps in more than ``min_share`` of the folds and cuts the
+    pooled test RMSE by the rule's margins; the text says which check decided."""
+    n, k = len(evidence.before), int(evidence.helped.sum())
+    before, after = evidence.pooled_before, evidence.pooled_after
+    gain = before - after
+    checks = [
+        (n > 0 and k > rule.min_share * n, f"helps in {k} of {n} folds"),
+        (
+            gain >= rule.min_improvement * before and gain >= rule.min_improvement_k,
+            f"pooled test RMSE {before:.3f} → {after:.3f} K ({-gain / before:+.0%})",
+        ),
+    ]
+    ok = all(passed for passed, _ in checks)
+    return ok, "; ".join(text for passed, text in checks if ok or not passed)
+
+
+def head_to_head(first: FoldEvidence, second: FoldEvidence) -> tuple[int, str]:
+    """Which of two extensions that both passed explains the folds better: 0 or 1, and why.
+
+    Compared on the pooled test RMSE; the loser's text names the margin and in how many folds
+    it was better anyway (so a close call reads as one).
+    """
+    a, b = first.pooled_after, second.pooled_after
+    wins_b = int((second.rmse_after < first.rmse_after).sum())
+    winner = 0 if a <= b else 1
+    n = len(first.after)
+    loser_wins = wins_b if winner == 0 else n - wins_b
+    lo, hi = sorted((a, b))
+    return winner, (
+        f"pooled test RMSE {hi:.3f} K against the winner's {lo:.3f} K; "
+        f"better in {loser_wins} of {n} folds"
+    )

@@ -1,0 +1,218 @@
+"""Is the base model healthy? A fitted baseline checked before any extension is weighed against it.
+
+An extension is judged by how much it improves on the base model; against a crippled base model
+any flexible extension "wins". A baseline is inadequate when
+
+- a parameter rests on a bound derived from the building (:mod:`rcengine.models.bounds`): the
+  fit wants a construction this building cannot have — within ``BOUND_MARGIN`` of the searched
+  range, in the search space's scale (log for capacities and resistances). A parameter at a
+  lower bound of 0 (no solar aperture) is a note, not a reason: "none" is physical;
+- its heat-loss coefficient, or its effective aperture to ghi, lies outside the range the
+  building's envelope allows (per-parameter bounds do not bound a sum of resistances, nor the
+  share of a wall node's solar heat that reaches the air);
+- its test error is poor. Poor is defined against forecasts that know nothing of the weather,
+  the gains or the heating: the indoor temperature measured at the same local time a day and a
+  week earlier (the building's daily and weekly routines), and a constant at the measured mean
+  (the error of which is the temperature's standard deviation). A physical model driven by the
+  measured inputs that does not beat the best of them has not captured what drives the building.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+
+from rcengine.building import Building
+from rcengine.columns import GHI
+from rcengine.estimation.search_space import SearchSpace
+from rcengine.metrics import rmse
+from rcengine.models.bounds import envelope, heat_loss_coefficient, solar_aperture_max
+from rcengine.models.physical import solar_apertures, ua
+from rcengine.network import CompiledNetwork, RCNetwork
+
+# "On a bound": within 1 % of the searched range of the bound (a factor 1.06 on a 2.5-decade
+# log range) — closer than an interior estimate of a physical quantity is worth.
+BOUND_MARGIN = 0.01
+
+NAIVE_FORECASTS = {
+    "yesterday": "the temperature measured at the same time a day earlier",
+    "last week": "the temperature measured at the same time a week earlier",
+    "constant": "a constant at the measured mean",
+}
+
+# What a bound means, by the parameter's kind (name prefix): below the lower, above the upper.
+_BOUND_MEANING = {
+    "c_": (
+        "stores less heat than even the lightest construction of this building could",
+        "stores more heat than any construction of this building could",
+    ),
+    "r_": (
+        "a resistance below what any construction of this building could have",
+        "a resistance beyond what any construction of this building could have",
+    ),
+    "alpha_": (
+        "less sun than the building could admit",
+        "more sun than this building's glazing and envelope could admit",
+    ),
+}
+
+Verdict = Literal["healthy", "inadequate"]
+
+
+@dataclass(frozen=True)
+class FitQuality:
+    """Test-period errors [K]: the model's simulation and each naive forecast's (``naive``,
+    keyed as ``NAIVE_FORECASTS``)."""
+
+    rmse: float
+    naive: dict[str, float]
+
+    @property
+    def best_naive(self) -> tuple[str, float]:
+        name = min(self.naive, key=self.naive.__getitem__)
+        return name, self.naive[name]
+
+
+def same_time_earlier(
+    measured: pd.Series, times: pd.DatetimeIndex, days: int, timezone: str
+) -> np.ndarray:
+    """``measured`` at the same local clock time ``days`` earlier than each of ``times``; NaN
+    where not recorded, or in the hour a daylight-saving change repeats or skips. [°C]"""
+    wall_clock = times.tz_convert(timezone).tz_localize(None) - pd.Timedelta(days=days)
+    source = wall_clock.tz_localize(timezone, ambiguous="NaT", nonexistent="NaT")
+    return measured.reindex(source.tz_convert(measured.index.tz)).to_numpy(dtype=float)
+
+
+def fit_quality(
+    measured: pd.Series, times: pd.DatetimeIndex, simulated: np.ndarray, timezone: str
+) -> FitQuality:
+    """The model's and the naive forecasts' RMSE over the test instants ``times``.
+
+    measured: indoor temperature of the whole record, training included, so that the day- and
+    week-old values exist [°C]; simulated: the model over ``times`` [°C].
+    """
+    actual = measured.reindex(times).to_numpy(dtype=float)
+    forecasts = {
+        "yesterday": same_time_earlier(measured, times, 1, timezone),
+        "last week": same_time_earlier(measured, times, 7, timezone),
+        "constant": np.full(len(times), np.nanmean(actual)),
+    }
+    naive = {
+        name: rmse(actual, f)
+        for name, f in forecasts.items()
+        if (np.isfinite(actual) & np.isfinite(f)).any()
+    }
+    return FitQuality(rmse(actual, simulated), naive)
+
+
+@dataclass(frozen=True)
+class Health:
+    """The verdict on a base model: ``reasons`` it cannot represent the building (none when
+    healthy), the parameters ``on_bounds`` and ``notes`` that do not count against it."""
+
+    reasons: tuple[str, ...]
+    on_bounds: tuple[str, ...]
+    notes: tuple[str, ...] = ()
+
+    @property
+    def verdict(self) -> Verdict:
+        return "inadequate" if self.reasons else "healthy"
+
+    @property
+    def healthy(self) -> bool:
+        return not self.reasons
+
+    def summary(self) -> str:
+        if self.healthy:
+            return "the base model represents this building"
+        return "the base model cannot represent this building: " + "; ".join(self.reasons)
+
+
+def check_health(
+    network: RCNetwork | CompiledNetwork,
+    params: Mapping[str, float],
+    quality: FitQuality,
+    *,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    building: Building | None = None,
+    margin: float = BOUND_MARGIN,
+) -> Health:
+    """Judge a fitted base model (see the module docstring).
+
+    bounds: the bounds it was fitted within (default: the network's own); building: checks
+    the heat loss against its envelope and names its size in the reasons.
+    """
+    net = network.compile() if isinstance(network, RCNetwork) else network
+    on_bounds, reasons, notes = _bound_findings(net, params, bounds, margin)
+    if building is not None:
+        reasons.extend(_envelope_findings(net, params, building))
+    reasons.extend(_fit_findings(net.name, quality, building))
+    return Health(tuple(reasons), tuple(on_bounds), tuple(notes))
+
+
+def _bound_findings(
+    net: CompiledNetwork,
+    params: Mapping[str, float],
+    bounds: Mapping[str, tuple[float, float]] | None,
+    margin: float,
+) -> tuple[list[str], list[str], list[str]]:
+    """Parameters on a bound, the reasons they give and the notes (zero lower bounds)."""
+    space = SearchSpace(net, bounds=bounds)
+    theta = net.as_theta(dict(params))
+    on_bounds = space.at_bounds(space.to_unit(theta)[0], margin)
+    reasons, notes = [], []
+    for name in on_bounds:
+        i = space.free.index(name)
+        value, lower, upper = theta[0, net.param_names.index(name)], space.lower[i], space.upper[i]
+        at_upper = bool(abs(value - upper) < abs(value - lower))
+        parameter = net.parameters[name]
+        if not at_upper and lower == 0.0:
+            notes.append(f"{name} ≈ 0 ({value:.3g} {parameter.unit}): the fit does without it")
+            continue
+        side, bound = ("upper", upper) if at_upper else ("lower", lower)
+        meaning = next(
+            (m[at_upper] for prefix, m in _BOUND_MEANING.items() if name.startswith(prefix)),
+            "outside what this building's description allows",
+        )
+        reasons.append(
+            f"{name} ended on its {side} bound {bound:.3g} {parameter.unit}: {meaning}"
+        )
+    return on_bounds, reasons, notes
+
+
+def _envelope_findings(
+    net: CompiledNetwork, params: Mapping[str, float], building: Building
+) -> list[str]:
+    """The fitted UA, and the effective aperture to ghi, against what the building allows."""
+    env = envelope(building)
+    checks = [("heat-loss coefficient", ua(net, dict(params)), heat_loss_coefficient(env), "W/K")]
+    apertures = solar_apertures(net, dict(params))
+    if GHI in apertures:
+        checks.append(("solar aperture", apertures[GHI], (0.0, solar_aperture_max(env)), "m²"))
+    reasons = []
+    for what, value, (least, most), unit in checks:
+        if not least <= value <= most:
+            side, bound = ("below", least) if value < least else ("above", most)
+            reasons.append(
+                f"its {what} {value:.3g} {unit} is {side} {bound:.3g} {unit}, the "
+                f"{'least' if side == 'below' else 'most'} this building's envelope allows"
+            )
+    return reasons
+
+
+def _fit_findings(model: str, quality: FitQuality, building: Building | None) -> list[str]:
+    """A test error no better than the best naive forecast."""
+    if not quality.naive:
+        return []
+    name, best = quality.best_naive
+    if quality.rmse < best:
+        return []
+    of = f"a {building.floor_area:.0f} m² building" if building is not None else "this building"
+    return [
+        f"test RMSE {quality.rmse:.2g} K is poor for a {model} of {of}: no better than "
+        f"{NAIVE_FORECASTS[name]} ({best:.2g} K), which knows nothing of the weather or the gains"
+    ]

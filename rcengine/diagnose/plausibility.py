@@ -1,0 +1,323 @@
+"""Is a fitted extension physically possible? Its magnitudes in physical units, checked against
+the building.
+
+Every candidate (``candidates.CANDIDATES``) is parameterised in physical units — a g-value, an
+absorptance, air changes per hour, W per m² of floor, a floor U-value, a capacity per m² — so a
+refit answers a physical question: how much of this effect would the building need for the
+model to match the data? An answer no real building gives (a g-value above that of single clear
+glass, 8 air changes an hour, 60 W/m² of unmetered heat) says the candidate is absorbing some
+other effect, and the candidate is rejected with that reason.
+
+``READERS`` holds, per effect id, the function turning fitted parameters into ``Reading`` s (value,
+unit, meaning, plausible range); the ranges are the constants below, each with its source. The
+candidates' search bounds are wider (``SEARCH_MARGIN``) so an implausible magnitude can be fitted,
+and then seen.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from rcengine.columns import Q_HVAC, SOLAR_OPAQUE, solar_orientation_signal
+from rcengine.models.bounds import (
+    ABSORPTANCE_MAX,
+    G_GLAZING_MAX,
+    KAPPA_INTERNAL,
+    U_GLAZING,
+    U_GROUND_MAX,
+    opaque_solar_share_max,
+)
+from rcengine.models.physical import solar_apertures
+
+if TYPE_CHECKING:
+    from rcengine.diagnose.candidates import Extension
+
+Range = tuple[float, float]
+
+# A candidate's search bounds reach this many times past its plausible range, so a fit that needs
+# an impossible magnitude can say so instead of stopping on a bound that looks plausible. [-]
+SEARCH_MARGIN = 2.0
+# Total solar energy transmittance: solar-control glazing behind shading (g_tot ≈ 0.1, EN 410 and
+# EN ISO 52022-1) to single clear glass (EN 410, the base models' ``G_GLAZING_MAX``). [-]
+G_VALUE: Range = (0.1, G_GLAZING_MAX)
+# Solar absorptance of an opaque outer surface: white paint or polished metal (≈ 0.1–0.2) to dark
+# paint or roofing (ASHRAE Fundamentals 2017 ch. 33 Table 5). [-]
+ABSORPTANCE: Range = (0.1, ABSORPTANCE_MAX)
+# Scheduled outdoor-air ventilation: offices run 0.5–2 air changes/h (EN 16798-1 Annex B, ASHRAE
+# 62.1); 5 is a purge or night-flushing rate. [1/h]
+VENTILATION_ACH: Range = (0.0, 5.0)
+# Wind-driven infiltration: the wind coefficient of leaky dwellings (LBL / Sherman–Grimsrud, n50
+# ≈ 10 1/h) is ≈ 0.1–0.2 air changes/h per m/s; 0.5 is a building with windows open. [1/h per m/s]
+WIND_ACH_PER_M_S: Range = (0.0, 0.5)
+# Internal heat not in the data: occupants ≈ 5–10 W/m² and office equipment 5–25 W/m² (EN 16798-1
+# Annex C, ASHRAE Fundamentals 2017 ch. 18); 40 is a dense, equipment-heavy floor. [W/m² floor]
+UNMETERED_W_M2: Range = (0.0, 40.0)
+# Ground floor U-value: a slab under 300 mm of insulation to an uninsulated slab of a small
+# building (ISO 13370, the base models' ``U_GROUND_MAX``). [W/(m²K)]
+U_FLOOR: Range = (0.05, U_GROUND_MAX)
+# The soil under a floor lies between the outdoor annual mean and the indoor temperature (heat
+# flows from the one to the other, ISO 13370); the margin covers their estimates. [K]
+GROUND_TEMPERATURE_MARGIN_K = 2.0
+# Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
+# −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
+STEFAN_BOLTZMANN = 5.670e-8
+SKY_COUPLING: Range = (
+    0.1 * 4 * STEFAN_BOLTZMANN * 253.15**3,
+    0.95 * 4 * STEFAN_BOLTZMANN * 303.15**3,
+)
+# Storage the model lacks, per m² of floor: the base models' internal-mass range (10–1000 kJ).
+EXTRA_CAPACITY_J_M2K: Range = KAPPA_INTERNAL
+# Emitter time constant: a fan coil or convector (minutes) to a screeded underfloor system
+# (≈ a day, EN 1264 / Koschenz & Lehmann). [h]
+EMITTER_TAU_H: Range = (0.05, 24.0)
+# Emitter capacity per m² of floor: up to 80 mm of dense screed over the whole floor
+# (0.08 m · 2400 kg/m³ · 1000 J/(kg·K), EN ISO 10456). [J/(m²K)]
+EMITTER_CAPACITY_J_M2K: Range = (0.0, 0.08 * 2400.0 * 1000.0)
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One fitted magnitude in physical units; ``plausible`` None when it is reported only, and
+    ``of`` names what the range covers, for the reason ("exceeds any glazing")."""
+
+    key: str
+    value: float
+    unit: str
+    meaning: str
+    plausible: Range | None = None
+    of: str = ""
+
+    def problem(self) -> str | None:
+        """The plain-words reason this magnitude is impossible, or None."""
+        if self.plausible is None:
+            return None
+        low, high = self.plausible
+        unit = "" if self.unit == "-" else f" {self.unit}"
+        value = f"{self.meaning}: {self.value:.3g}{unit}"
+        if self.value > high:
+            return f"{value} exceeds any {self.of} (≤ {high:.3g}{unit})"
+        if self.value < low:
+            return f"{value} is below any {self.of} (≥ {low:.3g}{unit})"
+        return None
+
+    def as_dict(self) -> dict:
+        return {"value": self.value, "unit": self.unit, "meaning": self.meaning}
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """The fitted extension's magnitudes ``{key: {value, unit, meaning}}`` and the reasons, in
+    plain words, that any of them is impossible for the building."""
+
+    magnitudes: dict[str, dict]
+    problems: list[str]
+
+    @property
+    def plausible(self) -> bool:
+        return not self.problems
+
+
+def assess(ext: Extension, params: Mapping[str, float]) -> Assessment:
+    """Read the fitted ``params`` (at least the extension's new parameters) of ``ext`` in
+    physical units and check each against its plausible range."""
+    readings = READERS[ext.effect](ext, params)
+    problems = [p for r in readings if (p := r.problem()) is not None]
+    return Assessment({r.key: r.as_dict() for r in readings}, problems)
+
+
+def _area_mean(values: Mapping[str, float], areas: Mapping[str, float]) -> float:
+    return sum(values[k] * areas[k] for k in values) / sum(areas[k] for k in values)
+
+
+def _by_orientation(
+    ext: Extension, values: Mapping[str, float], name: str, what: tuple[str, str], full: Range
+) -> list[Reading]:
+    """One reading per orientation ``{key: value}``, at most the top of ``full`` (a weakly lit
+    facade's fit is loose below it), and their area-weighted mean within ``full``; ``what`` is
+    (the quantity, the surfaces): ("implied g-value", "glazing")."""
+    orientations = ext.detail["orientations"]
+    quantity, surfaces = what
+    of = surfaces.removesuffix("s")
+    readings = [
+        Reading(
+            f"{name}_{k}",
+            value,
+            "-",
+            f"{quantity} of the {orientations[k]['facade']} {surfaces}",
+            (0.0, full[1]),
+            of,
+        )
+        for k, value in values.items()
+    ]
+    areas = {k: v["area_m2"] for k, v in orientations.items()}
+    mean = _area_mean(values, areas)
+    return [*readings, Reading(f"{name}_mean", mean, "-", f"area-weighted {quantity}", full, of)]
+
+
+def _window(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    """Implied g-value per orientation, g_k (to the mass) + g_air (to the air), each at most that
+    of clear glass; their area-weighted mean at least that of shaded solar-control glazing."""
+    air = params.get("g_window_air", 0.0)
+    g = {k: params[f"g_window_{k}"] + air for k in ext.detail["orientations"]}
+    readings = _by_orientation(ext, g, "g", ("implied g-value", "glazing"), G_VALUE)
+    if "g_window_air" in params:
+        readings.append(Reading("g_air", air, "-", "part of the g-value heating the air directly"))
+    if "r_window" in params:
+        u = 1.0 / params["r_window"]
+        readings.append(
+            Reading(
+                "u_glazing", u, "W/(m²K)", "U-value of the glazing", (0.0, U_GLAZING[1]), "glazing"
+            )
+        )
+    return readings
+
+
+def _opaque(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    """Absorptance per orientation (at most the darkest surface's), their area-weighted mean, and
+    the steady share of the sun on the walls that reaches the indoor air, at most α·R_se·U of the
+    darkest, least insulated wall (ISO 13790 Eq. 44)."""
+    orientations = ext.detail["orientations"]
+    alpha = {k: params[f"a_opaque_{k}"] for k in orientations}
+    what = ("solar absorptance", "opaque surfaces")
+    readings = _by_orientation(ext, alpha, "absorptance", what, ABSORPTANCE)
+    if set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals:
+        apertures = solar_apertures(ext.network, dict(params))
+        shares = {k: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] for k in orientations}
+        areas = {k: v["area_m2"] for k, v in orientations.items()}
+        readings.append(
+            Reading(
+                "inward_share",
+                _area_mean(shares, areas),
+                "-",
+                "share of the sun on the opaque surfaces reaching the indoor air",
+                (0.0, opaque_solar_share_max()),
+                "wall (α·R_se·U)",
+            )
+        )
+    return readings
+
+
+def _ventilation(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    ach = params["ach_vent"]
+    meaning = f"air changes in the scheduled hours, of {ext.detail['volume_m3']:g} m³"
+    return [Reading("ach", ach, "1/h", meaning, VENTILATION_ACH, "ventilated building")]
+
+
+def _wind(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    meaning = f"wind-driven air changes per m/s of wind, of {ext.detail['volume_m3']:g} m³"
+    return [
+        Reading(
+            "ach_per_wind", params["ach_wind"], "1/h per m/s", meaning, WIND_ACH_PER_M_S, "envelope"
+        )
+    ]
+
+
+def _unmetered(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    floor = ext.detail["floor_area_m2"]
+    q = params["q_unmetered"]
+    return [
+        Reading(
+            "gain_per_floor_area",
+            q,
+            "W/m²",
+            f"unmetered internal gain in the scheduled hours, per m² of floor ({q * floor:.0f} W)",
+            UNMETERED_W_M2,
+            "occupied floor",
+        )
+    ]
+
+
+def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    """Floor U-value 1/r_floor and the fitted mean ground temperature: the damped outdoor annual
+    mean raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base))."""
+    d = ext.detail
+    r = params["r_floor"]
+    t_ground = d["ground_base_c"] + params["q_ground"] * r
+    low = d["outdoor_mean_c"] - GROUND_TEMPERATURE_MARGIN_K
+    high = d["indoor_mean_c"] + GROUND_TEMPERATURE_MARGIN_K
+    return [
+        Reading("u_floor", 1.0 / r, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),
+        Reading(
+            "t_ground",
+            t_ground,
+            "°C",
+            "mean ground temperature under the floor over the training period",
+            (low, high),
+            "soil between the outdoor annual mean and the indoor air",
+        ),
+    ]
+
+
+def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    area = ext.detail["sky_view_area_m2"]
+    return [
+        Reading(
+            "sky_coupling",
+            params["h_sky"],
+            "W/(m²K)",
+            f"long-wave coupling ε·h_r to the sky, per m² of roof + ½ wall ({area:g} m²)",
+            SKY_COUPLING,
+            "envelope surface (ε·4σT³)",
+        )
+    ]
+
+
+def _mass(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    c, r = params["c_mass_extra"], params["r_mass_extra"]
+    low, high = ext.detail["coupling_range_m2k_w"]
+    return [
+        Reading(
+            "extra_capacity",
+            c / 1e3,
+            "kJ/(m²K)",
+            "added heat capacity per m² of floor",
+            (EXTRA_CAPACITY_J_M2K[0] / 1e3, EXTRA_CAPACITY_J_M2K[1] / 1e3),
+            "building's internal mass",
+        ),
+        Reading(
+            "coupling_resistance",
+            r,
+            "m²K/W",
+            "resistance between the air and the added capacity, per m² of floor",
+            (low, high),
+            "surface film and covering",
+        ),
+        Reading("time_constant", c * r / 3600.0, "h", "time constant of the added capacity"),
+    ]
+
+
+def _emitter(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    c, r = params["c_emitter"], params["r_emitter"]
+    return [
+        Reading(
+            "emitter_capacity",
+            c / 1e3,
+            "kJ/(m²K)",
+            "emitter heat capacity per m² of floor",
+            (EMITTER_CAPACITY_J_M2K[0] / 1e3, EMITTER_CAPACITY_J_M2K[1] / 1e3),
+            "emitter (screed included)",
+        ),
+        Reading(
+            "emitter_time_constant",
+            c * r / 3600.0,
+            "h",
+            "emitter time constant",
+            EMITTER_TAU_H,
+            "emitter (fan coil to screeded floor)",
+        ),
+    ]
+
+
+READERS: dict[str, Callable[[Extension, Mapping[str, float]], list[Reading]]] = {
+    "window_solar_gains": _window,
+    "opaque_solar_gains": _opaque,
+    "wind_infiltration": _wind,
+    "ventilation_schedule": _ventilation,
+    "ground_coupling": _ground,
+    "sky_radiation": _sky,
+    "unmetered_gains": _unmetered,
+    "thermal_mass": _mass,
+    "emitter_dynamics": _emitter,
+}

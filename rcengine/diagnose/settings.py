@@ -1,0 +1,68 @@
+"""What a diagnosis is asked to do: the train/test split, the estimator presets, the acceptance
+margins and the forward selection's budget."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Literal
+
+import pandas as pd
+
+from rcengine.diagnose.candidates import CANDIDATES
+from rcengine.diagnose.folds import FoldRule
+
+
+@dataclass(frozen=True)
+class DiagnoseSettings:
+    """train_fraction: share of the record (whole days) used for fitting, the rest is the test;
+    preset: estimator preset of the baseline and of every refit that adds inputs;
+    structural_preset: of refits that add a state (a new capacitor brings new basins, which the
+    longer GA of "default" explores); confirm: candidates refitted per round after the first
+    (which refits them all); min_improvement: relative test-RMSE cut an extension must bring,
+    and min_improvement_k in kelvin (0.1 K, a room sensor's accuracy: smaller gains are no
+    evidence of physics); bic_margin: how much the effective-n BIC must drop; max_rounds:
+    forward-selection rounds; baseline_starts: independent searches for the baseline fit (best
+    kept); workers: processes for the refits of a round (default: every core); effects: the
+    candidate ids to consider (default: the whole vocabulary); bounds: the base model's
+    parameter bounds, "building" (derived from its description) or "thesis" (Table 2.3);
+    evidence: "folds" confirms an extension that passes the single split on rolling folds across
+    the record (fold_train_days of training, the next fold_test_days tested, up to max_folds
+    origins, each refitted with fold_preset; accepted when it helps in more than
+    min_fold_share of them and on the pooled test), "split" judges on the single split alone."""
+
+    train_fraction: float = 0.5
+    preset: str = "study"
+    structural_preset: str = "default"
+    confirm: int = 3
+    min_improvement: float = 0.10
+    min_improvement_k: float = 0.1
+    bic_margin: float = 10.0
+    max_rounds: int = 3
+    baseline_starts: int = 4
+    workers: int = field(default_factory=lambda: os.cpu_count() or 1)
+    random_state: int = 0
+    effects: tuple[str, ...] = tuple(CANDIDATES)
+    bounds: Literal["building", "thesis"] = "building"
+    evidence: Literal["folds", "split"] = "folds"
+    fold_train_days: int = 28
+    fold_test_days: int = 14
+    max_folds: int = 6
+    fold_preset: str = "study"
+    min_fold_share: float = 0.5
+
+    @property
+    def fold_rule(self) -> FoldRule:
+        """The fold rule with this diagnosis's improvement margins."""
+        return FoldRule(self.min_fold_share, self.min_improvement, self.min_improvement_k)
+
+
+def split_time(frame: pd.DataFrame, fraction: float, timezone: str) -> pd.Timestamp:
+    """Local midnight closest to ``fraction`` of the record, so train and test are whole days."""
+    if not 0.1 <= fraction <= 0.9:
+        raise ValueError(f"train_fraction must be within [0.1, 0.9], got {fraction}")
+    t = frame.index[int(len(frame) * fraction)].tz_convert(timezone)
+    midnight = t.normalize()
+    if t - midnight > pd.Timedelta(hours=12):
+        midnight += pd.Timedelta(days=1)
+    return midnight.tz_convert("UTC")

@@ -1,0 +1,146 @@
+"""The diagnosis's verdict, its evidence across rolling folds, the head to head between candidates
+that both pass, and the base model's health in the report (issue 11, items 2, 4 and 5)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose.folds import FoldEvidence, rolling_folds
+from rcengine.diagnose.health import Health
+from rcengine.diagnose.html import render
+from rcengine.diagnose.report import Finding, confirm_on_folds, reject_implausible, verdict
+from rcengine.diagnose.selection import _winner
+from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from tests.test_diagnose import _hidden_gain
+
+HEALTHY = Health(reasons=(), on_bounds=())
+CRIPPLED = Health(
+    reasons=("c_wall ended on its upper bound 7.5e+05 J/(K·m²): stores more heat than any "
+             "construction of this building could",),
+    on_bounds=("c_wall",),
+)
+
+
+def _finding(effect: str, accepted: bool, **fields) -> Finding:
+    """A made-up refitted finding: test RMSE 1.0 → 0.5 K."""
+    defaults = dict(
+        round=1,
+        screen_explained=0.5,
+        screen_method="projection",
+        rmse_test_before=1.0,
+        rmse_train_before=1.0,
+        rmse_test_after=0.5,
+        rmse_train_after=0.5,
+        reason="accepted: test RMSE 1.000 → 0.500 K (-50%); ΔBIC -40.0",
+    )
+    return Finding(effect, accepted, **{**defaults, **fields})
+
+
+def _evidence(before: list[float], after: list[float]) -> FoldEvidence:
+    """Fold evidence whose test residuals are constant: each fold's RMSE is the value given."""
+    return FoldEvidence(
+        tuple(np.full(48, b) for b in before), tuple(np.full(48, a) for a in after)
+    )
+
+
+def test_verdict_names_what_is_missing_or_that_nothing_is():
+    wind = _finding("wind_infiltration", True)
+    mass = _finding("thermal_mass", False)
+    gains = _finding("unmetered_gains", True, round=2)
+    assert verdict([], HEALTHY) == "nothing missing"
+    assert verdict([mass], None) == "nothing missing"
+    assert verdict([wind, mass], HEALTHY) == "missing: wind_infiltration"
+    assert verdict([wind, gains, mass], HEALTHY) == "missing: wind_infiltration, unmetered_gains"
+
+
+def test_verdict_says_the_base_model_is_inadequate_and_what_was_found_against_it():
+    wind = _finding("wind_infiltration", True)
+    text = verdict([wind], CRIPPLED)
+    assert text.startswith("base model inadequate: c_wall ended on its upper bound")
+    assert text.endswith("judged against it anyway: missing: wind_infiltration")
+    # Repaired by the structural step: the verdict says so and names only what was found after.
+    repair = _finding("thermal_mass", True, round=0, baseline_repair=True)
+    text = verdict([repair, wind], CRIPPLED)
+    assert text.endswith("— healthy with thermal_mass, then missing: wind_infiltration"), text
+    assert verdict([repair], CRIPPLED).endswith("healthy with thermal_mass, then nothing missing")
+
+
+def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
+    folds = rolling_folds(
+        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
+    )
+    lucky = _finding("opaque_solar_gains", True)
+    confirm_on_folds(lucky, _evidence([1, 1, 1], [0.5, 1.2, 1.3]), folds, DiagnoseSettings(),
+                     "Europe/Rome")
+    assert not lucky.accepted
+    assert lucky.reason.startswith("rejected across folds: helps in 1 of 3 folds")
+    assert [f["rmse_test_after"] for f in lucky.folds["folds"]] == [0.5, 1.2, 1.3]
+    assert lucky.folds["folds"][0]["test"] == folds[0].label("Europe/Rome")
+    steady = _finding("window_solar_gains", True)
+    confirm_on_folds(steady, _evidence([1, 1, 1], [0.6, 0.7, 0.8]), folds, DiagnoseSettings(),
+                     "Europe/Rome")
+    assert steady.accepted and "across folds: helps in 3 of 3 folds" in steady.reason
+    assert steady.folds["helped"] == 3 and steady.folds["pooled_rmse_test_before"] == 1.0
+
+
+def test_of_two_passing_candidates_the_head_to_head_winner_is_taken_and_the_other_reported():
+    window = _finding("window_solar_gains", True, evidence=_evidence([1, 1, 1], [0.6, 0.7, 0.5]))
+    opaque = _finding(
+        "opaque_solar_gains", True, rmse_test_after=0.4,  # better on the single split
+        evidence=_evidence([1, 1, 1], [0.8, 0.6, 0.9]),
+    )
+    verdicts = {"opaque_solar_gains": opaque, "window_solar_gains": window}
+    best = _winner([opaque, window], verdicts, 1)
+    assert best is window and list(verdicts) == ["opaque_solar_gains"]
+    assert not opaque.accepted and opaque.lost_to["effect"] == "window_solar_gains"
+    assert "better in 1 of 3 folds" in opaque.lost_to["reason"]
+    assert opaque.reason.startswith("not taken in round 1: lost to window_solar_gains")
+    assert window.runner_up == {"effect": "opaque_solar_gains", "reason": opaque.lost_to["reason"]}
+
+
+def test_an_implausible_magnitude_rejects_the_finding_with_its_reason():
+    gains = _finding("unmetered_gains", True)
+    magnitudes = {"q_unmetered": {"value": 180.0, "unit": "W/m²"}}
+    reject_implausible(gains, magnitudes, ["180 W/m² of floor is more than any occupancy"])
+    assert not gains.accepted and gains.magnitudes == magnitudes
+    assert gains.reason == "rejected as implausible: 180 W/m² of floor is more than any occupancy"
+    assert gains.to_dict()["magnitudes"] == magnitudes
+
+
+@pytest.fixture(scope="module")
+def gain_report():
+    """The three-week synthetic building with a hidden weekday gain, judged on six folds of a
+    week's training and three days' test."""
+    inputs = weather_and_gains(21)
+    truth_inputs = inputs.assign(q_occ=inputs["q_occ"] + _hidden_gain(inputs.index))
+    frame = inputs.assign(t_in=basic_reference(truth_inputs, TRUTH_BASIC, (15.0, 19.0, 19.0)))
+    settings = DiagnoseSettings(train_fraction=0.6, fold_train_days=7, fold_test_days=3)
+    return diagnose(frame, BUILDING, "basic", settings)
+
+
+def test_the_hidden_gain_is_confirmed_across_the_folds(gain_report):
+    d = json.loads(gain_report.to_json())
+    assert d["evidence"]["method"] == "folds" and len(d["evidence"]["folds"]) == 6
+    first = next(f for f in d["findings"] if f["accepted"])
+    assert first["effect"] == "unmetered_gains"
+    folds = first["folds"]
+    assert len(folds["folds"]) == 6 and folds["helped"] > 3
+    assert folds["pooled_rmse_test_after"] <= 0.5 * folds["pooled_rmse_test_before"]
+    assert "across folds: helps in" in first["reason"]
+    assert "across rolling folds: helps in" in render(gain_report)
+
+
+def test_a_baseline_no_better_than_a_constant_gives_the_inadequate_verdict(gain_report):
+    # Without the 15 kW weekday gain the base model's test error exceeds the spread of the
+    # measured temperature: it is inadequate, and the gain is found against it anyway.
+    d = json.loads(gain_report.to_json())
+    health = d["baseline"]["health"]
+    assert health["verdict"] == "inadequate"
+    assert health["rmse_test"] > health["naive_rmse_test"]["constant"]
+    assert d["verdict"].startswith("base model inadequate: test RMSE")
+    assert "missing: unmetered_gains" in d["verdict"]

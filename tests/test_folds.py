@@ -1,0 +1,85 @@
+"""Rolling folds across a season and the rule that judges an extension on them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rcengine.diagnose.folds import (
+    FoldEvidence,
+    FoldRule,
+    head_to_head,
+    judge_folds,
+    rolling_folds,
+)
+
+TZ = "Europe/Rome"
+
+
+def _season(start: str = "2016-10-01", end: str = "2017-03-31") -> pd.DatetimeIndex:
+    return pd.date_range(start, end, freq="30min", tz=TZ).tz_convert("UTC")
+
+
+def test_folds_cover_the_season_on_local_midnights_across_dst():
+    folds = rolling_folds(_season(), TZ, train_days=28, test_days=14, max_folds=6)
+    assert len(folds) == 6
+    assert folds[0].train_start.tz_convert(TZ) == pd.Timestamp("2016-10-01", tz=TZ)
+    # The last fold's test ends on the last complete local day (31 March starts it).
+    assert folds[-1].test_end.tz_convert(TZ) == pd.Timestamp("2017-03-31", tz=TZ)
+    for f in folds:
+        for t in (f.train_start, f.test_start, f.test_end):
+            local = t.tz_convert(TZ)
+            assert (local.hour, local.minute) == (0, 0)  # also over the 30 Oct / 26 Mar changes
+        assert (f.test_start.tz_convert(TZ) - f.train_start.tz_convert(TZ)).days == 28
+    starts = [f.train_start for f in folds]
+    assert starts == sorted(starts) and len(set(starts)) == 6
+
+
+def test_short_record_gives_fewer_or_no_folds():
+    assert rolling_folds(_season("2017-01-01", "2017-01-30"), TZ, 28, 14) == []
+    folds = rolling_folds(_season("2017-01-01", "2017-02-14"), TZ, 28, 14, max_folds=6)
+    assert 1 <= len(folds) <= 3
+    with pytest.raises(ValueError, match="at least 1"):
+        rolling_folds(_season(), TZ, 0, 14)
+
+
+def _evidence(before: list[float], after: list[float], n: int = 200) -> FoldEvidence:
+    rng = np.random.default_rng(0)
+    unit = rng.standard_normal(n)
+    unit /= np.sqrt(np.mean(unit**2))  # exactly unit RMSE
+    return FoldEvidence(tuple(b * unit for b in before), tuple(a * unit for a in after))
+
+
+def test_rmse_and_pooled_rmse():
+    ev = _evidence([1.0, 2.0], [0.5, 1.0])
+    np.testing.assert_allclose(ev.rmse_before, [1.0, 2.0])
+    assert ev.pooled_before == pytest.approx(np.sqrt((1 + 4) / 2))
+    assert ev.pooled_after == pytest.approx(np.sqrt((0.25 + 1) / 2))
+
+
+def test_accepts_only_what_helps_in_most_folds():
+    rule = FoldRule()
+    ok, why = judge_folds(_evidence([1.0] * 6, [0.7] * 6), rule)
+    assert ok and "helps in 6 of 6 folds" in why
+    # One huge win carries the pooled RMSE but the effect hurts in four folds of six: a
+    # seasonal coincidence, not physics.
+    ok, why = judge_folds(_evidence([1, 1, 1, 1, 1, 3.0], [1.1, 1.1, 1.1, 1.1, 0.8, 0.5]), rule)
+    assert not ok and "helps in 2 of 6 folds" in why
+    # Helps everywhere but by less than a sensor's accuracy.
+    ok, why = judge_folds(_evidence([0.5] * 6, [0.45] * 6), rule)
+    assert not ok and "pooled test RMSE" in why and "folds" not in why
+
+
+def test_confidence_is_a_sign_test():
+    assert _evidence([1.0] * 6, [0.5] * 6).confidence == pytest.approx(1 - 0.5**6)
+    assert _evidence([1.0] * 6, [2.0] * 6).confidence == pytest.approx(0.0)
+
+
+def test_head_to_head_names_the_winner_and_the_margin():
+    strong = _evidence([1.0] * 4, [0.5] * 4)
+    weak = _evidence([1.0] * 4, [0.6, 0.6, 0.6, 0.4])
+    winner, why = head_to_head(strong, weak)
+    assert winner == 0
+    assert "better in 1 of 4 folds" in why
+    assert head_to_head(weak, strong)[0] == 1
