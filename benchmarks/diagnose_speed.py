@@ -14,41 +14,28 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
+import sys
 from pathlib import Path
 
-from rcengine.building import Building
-from rcengine.diagnose import diagnose
-from rcengine.diagnose.html import save_figures
-from rcengine.io.timeseries import read_timeseries
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
-VARIANTS = Path(__file__).resolve().parents[1] / "data" / "energyplus" / "variants"
+from benchmarks._cases import accepted_effects, diagnose_folder  # noqa: E402
+
+VARIANTS = ROOT / "data" / "energyplus" / "variants"
 MAX_RATIO = 0.7
 
 
 def is_correct(effect: str | None, report: dict) -> bool:
-    accepted = [f["effect"] for f in report["findings"] if f["accepted"]]
+    accepted = accepted_effects(report)
     if effect is None:
         return not accepted
     ratio = report["final"]["rmse_test"] / report["baseline"]["rmse_test"]
     return bool(accepted) and accepted[0] == effect and ratio <= MAX_RATIO
 
 
-def run_case(case: dict, out: Path | None) -> tuple[dict, float]:
-    folder = VARIANTS / case["case"]
-    building = Building.from_json(folder / "building.json")
-    frame = read_timeseries(folder / "data.csv")
-    started = time.perf_counter()
-    report = diagnose(frame, building, case["model"])
-    wall = time.perf_counter() - started
-    if out is not None:
-        (out / f"{case['case']}.json").write_text(report.to_json() + "\n")
-        save_figures(report, out, case["case"])
-    return json.loads(report.to_json()), wall
-
-
 def table_row(case: dict, report: dict, wall: float, correct: bool) -> str:
-    accepted = [f["effect"] for f in report["findings"] if f["accepted"]]
+    accepted = accepted_effects(report)
     base, final = report["baseline"]["rmse_test"], report["final"]["rmse_test"]
     return (
         f"| {case['case']} | {case['effect'] or '—'} | {accepted[0] if accepted else 'none'} | "
@@ -92,7 +79,7 @@ def main() -> None:
     ]
     walls, correct, sections = [], 0, []
     for case in cases:
-        report, wall = run_case(case, args.out)
+        report, wall = diagnose_folder(VARIANTS / case["case"], case["model"], args.out)
         sections.append(case_section(case, report))
         ok = is_correct(case["effect"], report)
         walls.append(wall)

@@ -13,6 +13,9 @@ Modules, lowest first:
   EPW header.
 - ``export``: simulate → contract frame (``rcengine.io.energyplus``) → CSV / building JSON.
 - ``cases``: the committed data sets, their checks and the variants' manifest.
+- ``archetypes``, ``variant``, ``testbed``: the diagnosis test bed — three building archetypes,
+  one building as EnergyPlus zones with its concealed-effect switches, the 28 cases with their
+  references, manifest and seeded split (``python scripts/make_testbed.py``).
 
 Entry point: ``python scripts/make_energyplus_data.py``. Our IDF text is written here; the
 EnergyPlus datasets serve only as sources of values.

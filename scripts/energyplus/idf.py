@@ -14,7 +14,16 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from datetime import date, timedelta
 
-from .library import AirGap, Construction, Gas, Glazing, Layer, Material, WeekSchedule
+from .library import (
+    AirGap,
+    Construction,
+    Gas,
+    Glazing,
+    Layer,
+    Material,
+    SimpleGlazing,
+    WeekSchedule,
+)
 
 Point2 = tuple[float, float]
 Point3 = tuple[float, float, float]
@@ -93,13 +102,15 @@ class VerticalRect:
 
 @dataclass(frozen=True)
 class Box:
-    """A rectangular zone: plan x0..x1 (west → east), y0..y1 (south → north), height. [m]"""
+    """A rectangular zone: plan x0..x1 (west → east), y0..y1 (south → north), height, floor
+    level z0. [m]"""
 
     x0: float
     x1: float
     y0: float
     y1: float
     height: float
+    z0: float = 0.0
 
     @property
     def floor_area(self) -> float:
@@ -118,10 +129,10 @@ class Box:
             "west": ((self.x0, self.y1), (self.x0, self.y0)),
         }
         left, right = corners[side]
-        return VerticalRect(left, right, 0.0, self.height)
+        return VerticalRect(left, right, self.z0, self.z0 + self.height)
 
     def roof(self) -> list[Point3]:
-        h = self.height
+        h = self.z0 + self.height
         return [
             (self.x0, self.y1, h),
             (self.x0, self.y0, h),
@@ -130,11 +141,12 @@ class Box:
         ]
 
     def floor(self) -> list[Point3]:
+        z = self.z0
         return [
-            (self.x1, self.y1, 0.0),
-            (self.x1, self.y0, 0.0),
-            (self.x0, self.y0, 0.0),
-            (self.x0, self.y1, 0.0),
+            (self.x1, self.y1, z),
+            (self.x1, self.y0, z),
+            (self.x0, self.y0, z),
+            (self.x0, self.y1, z),
         ]
 
 
@@ -284,6 +296,13 @@ def constant_schedule(name: str, value: float, limits: str = "Any") -> str:
     return idf_object("Schedule:Constant", name, limits, value)
 
 
+def sky_at_air_temperature() -> str:
+    """The sky radiates at the outdoor air temperature: no long-wave loss to a cold sky."""
+    return constant_schedule("Zero", 0.0) + idf_object(
+        "WeatherProperty:SkyTemperature", None, "DifferenceScheduleDryBulbValue", "Zero", "No"
+    )
+
+
 def week_schedule(name: str, week: WeekSchedule, limits: str = "Fraction") -> str:
     """Schedule:Compact of a weekday / Saturday / Sunday profile (no holidays in our runs)."""
     fields: list[object] = [name, limits, "Through: 12/31"]
@@ -335,6 +354,14 @@ def layer_object(m: Layer) -> str:
         )
     if isinstance(m, Gas):
         return idf_object("WindowMaterial:Gas", m.name, m.gas, m.thickness)
+    if isinstance(m, SimpleGlazing):
+        return idf_object(
+            "WindowMaterial:SimpleGlazingSystem",
+            m.name,
+            m.u_factor,
+            m.shgc,
+            m.visible_transmittance,
+        )
     raise TypeError(f"not a layer: {m!r}")
 
 

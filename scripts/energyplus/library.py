@@ -63,6 +63,20 @@ class Glazing:
 
 
 @dataclass(frozen=True)
+class SimpleGlazing:
+    """A whole glazing unit by its centre-of-glass figures (EnergyPlus's simple glazing model).
+
+    u_factor: with films [W/(m²·K)]; shgc: solar heat gain coefficient at normal incidence [-];
+    visible_transmittance [-].
+    """
+
+    name: str
+    u_factor: float
+    shgc: float
+    visible_transmittance: float
+
+
+@dataclass(frozen=True)
 class Gas:
     """A gas gap of a glazing unit. thickness [m]"""
 
@@ -71,7 +85,7 @@ class Gas:
     gas: str = "Air"
 
 
-Layer = Material | AirGap | Glazing | Gas
+Layer = Material | AirGap | Glazing | SimpleGlazing | Gas
 
 
 @dataclass(frozen=True)

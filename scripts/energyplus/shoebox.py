@@ -53,6 +53,7 @@ from .idf import (
     idf_object,
     materials_and_constructions,
     output_variables,
+    sky_at_air_temperature,
     week_schedule,
     window_surface,
 )
@@ -286,16 +287,7 @@ class Shoebox:
         if self.heavy_mass_area > 0.0:
             out.append(zones.internal_mass(ZONE, HEAVY_MASS.name, self.heavy_mass_area, "Concrete"))
         if self.sky_at_air_temperature:
-            out += [
-                constant_schedule("Zero", 0.0),
-                idf_object(
-                    "WeatherProperty:SkyTemperature",
-                    None,
-                    "DifferenceScheduleDryBulbValue",
-                    "Zero",
-                    "No",
-                ),
-            ]
+            out.append(sky_at_air_temperature())
         return out
 
     def _heating_outputs(self) -> tuple[str, ...]:
@@ -310,21 +302,8 @@ class Shoebox:
 
     def _heating(self) -> str:
         if self.replayed_heat is not None:
-            return replay_schedule("Replayed Heat", self.replayed_heat) + idf_object(
-                "OtherEquipment",
-                "Replayed Heat",
-                "None",
-                ZONE,
-                "Replayed Heat",
-                "EquipmentLevel",
-                1.0,
-                None,
-                None,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                "General",
+            return replay_schedule("Replayed Heat", self.replayed_heat) + zones.heat_into_air(
+                ZONE, "Replayed Heat"
             )
         if self.radiant_floor:
             return radiant_floor_heating()
@@ -336,54 +315,14 @@ class Shoebox:
 def radiant_floor_heating() -> str:
     """Electric radiant floor, 50 W/m², proportional on the air temperature over 2 K around
     the setpoint (full power at 20 °C, none at 22 °C), in office hours."""
-    return "".join(
-        [
-            idf_object(
-                "ConstructionProperty:InternalHeatSource",
-                "Radiant Floor Source",
-                RADIANT_FLOOR.name,
-                RADIANT_SOURCE_AFTER_LAYER,
-                RADIANT_SOURCE_AFTER_LAYER,
-                1,
-                0.15,
-                0.0,
-            ),
-            idf_object(
-                "ZoneHVAC:EquipmentConnections",
-                ZONE,
-                f"{ZONE} Equipment",
-                None,
-                None,
-                f"{ZONE} Air Node",
-                None,
-            ),
-            idf_object(
-                "ZoneHVAC:EquipmentList",
-                f"{ZONE} Equipment",
-                "SequentialLoad",
-                "ZoneHVAC:LowTemperatureRadiant:Electric",
-                "Radiant Floor",
-                1,
-                1,
-                None,
-                None,
-            ),
-            idf_object(
-                "ZoneHVAC:LowTemperatureRadiant:Electric",
-                "Radiant Floor",
-                "Heating Availability",
-                ZONE,
-                "Floor",
-                "HeatingDesignCapacity",
-                HEATING_CAPACITY_W_M2 * BOX.floor_area,
-                None,
-                None,
-                "MeanAirTemperature",
-                "HalfFlowPower",
-                2.0,
-                "Heating Setpoint",
-            ),
-        ]
+    return zones.radiant_floor_heating(
+        ZONE,
+        "Floor",
+        RADIANT_FLOOR.name,
+        RADIANT_SOURCE_AFTER_LAYER,
+        HEATING_CAPACITY_W_M2 * BOX.floor_area,
+        "Heating Setpoint",
+        "Heating Availability",
     )
 
 

@@ -197,3 +197,87 @@ def ideal_loads_heating(
 def single_heating_control_schedule() -> str:
     """Control-type schedule of ``ZoneControl:Thermostat``: 1 = single heating setpoint."""
     return constant_schedule("SingleHeatingControl", 1)
+
+
+def radiant_floor_heating(
+    zone_name: str,
+    surface: str,
+    construction: str,
+    source_after_layer: int,
+    capacity_w: float,
+    setpoint_schedule: str,
+    availability_schedule: str,
+    name: str = "Radiant Floor",
+) -> str:
+    """Electric radiant floor heating ``surface`` (whose ``construction`` holds the mat after
+    layer ``source_after_layer``), at most ``capacity_w``, proportional on the air temperature
+    over 2 K around the setpoint (full power 1 K below it, none 1 K above). [W]"""
+    return "".join(
+        [
+            idf_object(
+                "ConstructionProperty:InternalHeatSource",
+                f"{name} Source",
+                construction,
+                source_after_layer,
+                source_after_layer,
+                1,
+                0.15,
+                0.0,
+            ),
+            idf_object(
+                "ZoneHVAC:EquipmentConnections",
+                zone_name,
+                f"{zone_name} Equipment",
+                None,
+                None,
+                f"{zone_name} Air Node",
+                None,
+            ),
+            idf_object(
+                "ZoneHVAC:EquipmentList",
+                f"{zone_name} Equipment",
+                "SequentialLoad",
+                "ZoneHVAC:LowTemperatureRadiant:Electric",
+                name,
+                1,
+                1,
+                None,
+                None,
+            ),
+            idf_object(
+                "ZoneHVAC:LowTemperatureRadiant:Electric",
+                name,
+                availability_schedule,
+                zone_name,
+                surface,
+                "HeatingDesignCapacity",
+                capacity_w,
+                None,
+                None,
+                "MeanAirTemperature",
+                "HalfFlowPower",
+                2.0,
+                setpoint_schedule,
+            ),
+        ]
+    )
+
+
+def heat_into_air(zone_name: str, schedule: str, name: str | None = None) -> str:
+    """Heat put straight into the zone air, ``schedule`` giving the power. [W]"""
+    return idf_object(
+        "OtherEquipment",
+        name or schedule,
+        "None",
+        zone_name,
+        schedule,
+        "EquipmentLevel",
+        1.0,
+        None,
+        None,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        "General",
+    )

@@ -1,0 +1,295 @@
+"""Building archetypes of the diagnosis test bed, the constructions of its concealed effects and
+the civil calendar of a site — values; ``variant`` builds the EnergyPlus model from them.
+
+Each archetype is a grid of box zones — one or two rows (south, north) per storey, one or two
+storeys — in plan coordinates (x east, y north), turned by ``Variant.rotation_deg``.
+Constructions are listed outside → inside; U-values include ISO 6946 films.
+
+* ``light`` — timber-frame pavilion on piers, 12 m × 18 m × 3 m, one zone (216 m²). Painted
+  timber cladding on 154 mm batt (U 0.26), membrane roof on 200 mm board (U 0.16), insulated
+  timber floor over a ventilated crawl space (outdoor air, no sun, U 0.24), gypsum partitions
+  (1 m² per m² of floor). Older double glazing (U 2.7, g 0.70). 0.4 ACH; 1 person per 12 m²,
+  lights 8 W/m². Heating to 21 °C on weekdays 06:00–19:00, 15 °C otherwise.
+* ``heavy`` — two-storey masonry office, 24 m × 12 m, storeys of 3.3 m, south and north zones
+  on each storey (576 m², 4 zones): rendered 240 mm solid brick with 80 mm external insulation
+  (U 0.35), 200 mm concrete roof slab under 140 mm insulation (U 0.23), 200 mm concrete
+  floor slabs between storeys, brick partitions between zones and 0.6 m² of internal brick
+  walls per m² of floor; ground floor over a heated basement (adiabatic). Low-e double glazing
+  (U 1.4, g 0.55). 0.3 ACH; 1 person per 10 m², lights 7 W/m². Heating to 20 °C on weekdays
+  05:00–19:00, 16 °C otherwise.
+* ``open_plan`` — steel-frame open-plan floor, 35 m × 20 m × 4 m, one zone (700 m²): insulated
+  metal panels (100 mm PUR, U 0.24), metal-deck roof under 180 mm board (U 0.18), an exposed
+  200 mm concrete floor slab over a heated ground floor (adiabatic), light partitions (0.3 m²
+  per m²). Ribbon windows of double low-e glazing (U 1.8, g 0.60). 0.3 ACH; 1 person per
+  12 m², lights 9 W/m². Heating to 21 °C on weekdays 06:00–19:00, 16 °C otherwise.
+
+Every variant has windows on every facade (``Variant.wwr``), constant infiltration, metered
+people and lights on the office profiles, a heater of limited capacity
+(``Variant.heating_capacities``: ``capacity_factor`` × the design heat loss at the EPW's 99.6 %
+heating design temperature) and a holiday closure with the heating off (``Calendar``).
+Schedules run on civil time: EnergyPlus shifts them by an hour on its daylight-saving days
+(whole days, the change days included) while its clock and outputs stay on standard time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import date, timedelta
+
+from .idf import idf_object
+from .library import (
+    BRICK_100,
+    GYPSUM_19,
+    HEAVY_CONCRETE_100,
+    HEAVY_CONCRETE_200,
+    PARTITION,
+    WALL_AIR_SPACE,
+    WOOD_25,
+    Construction,
+    Material,
+    SimpleGlazing,
+)
+from .shoebox import SOIL_1000
+
+# --- materials (ASHRAE 2005 HOF values where the dataset has them) ----------------------------
+METAL = Material("F08 Metal surface", 0.0008, 45.28, 7824.0, 500.0, "Smooth")
+BATT_154 = Material("I05 154mm batt insulation", 0.1524, 0.045, 19.0, 960.0)
+BOARD_200 = Material("Insulation board 200mm", 0.2, 0.035, 30.0, 1210.0)
+BOARD_180 = Material("Insulation board 180mm", 0.18, 0.035, 30.0, 1210.0)
+BOARD_140 = Material("Insulation board 140mm", 0.14, 0.035, 30.0, 1210.0)
+EPS_80 = Material("EPS 80mm", 0.08, 0.035, 20.0, 1450.0)
+XPS_100 = Material("XPS 100mm", 0.1, 0.035, 35.0, 1450.0)
+PUR_100 = Material("PUR 100mm", 0.1, 0.025, 35.0, 1400.0)
+PUR_20 = Material("PUR 20mm", 0.02, 0.025, 35.0, 1400.0)
+MEMBRANE = Material("F13 Built-up roofing", 0.0095, 0.16, 1120.0, 1460.0, "Rough")
+SOLID_BRICK_240 = Material("Solid brick 240mm", 0.24, 0.72, 1800.0, 840.0, "Rough")
+RENDER = Material("Render 15mm", 0.015, 0.87, 1800.0, 840.0, "Rough")
+PLASTER = Material("Gypsum plaster 15mm", 0.015, 0.4, 1000.0, 1000.0, "Smooth")
+SCREED_50 = Material("Cement screed 50mm", 0.05, 1.4, 2000.0, 1000.0)
+
+# --- constructions (outside → inside) -------------------------------------------------------
+CLADDING = WOOD_25.surface("Timber cladding painted", 0.9, 0.45)
+TIMBER_WALL = Construction("Timber frame wall", (CLADDING, BATT_154, GYPSUM_19))
+LIGHT_ROOF = Construction(
+    "Light membrane roof", (MEMBRANE.surface("Membrane grey", 0.9, 0.6), BOARD_200, WOOD_25)
+)
+CRAWL_FLOOR = Construction("Timber floor over crawl space", (BATT_154, WOOD_25, WOOD_25))
+MASONRY_WALL = Construction(
+    "Insulated masonry wall",
+    (RENDER.surface("Render light", 0.9, 0.4), EPS_80, SOLID_BRICK_240, PLASTER),
+)
+CONCRETE_ROOF = Construction(
+    "Concrete roof",
+    (MEMBRANE.surface("Membrane grey", 0.9, 0.6), BOARD_140, HEAVY_CONCRETE_200, PLASTER),
+)
+CONCRETE_FLOOR = Construction("Concrete floor slab", (PLASTER, HEAVY_CONCRETE_200, SCREED_50))
+BRICK_PARTITION = Construction("Brick partition", (PLASTER, BRICK_100, PLASTER))
+PANEL_WALL = Construction(
+    "Insulated metal panel", (METAL.surface("Metal grey", 0.9, 0.5), PUR_100, METAL)
+)
+DECK_ROOF = Construction(
+    "Metal deck roof", (MEMBRANE.surface("Membrane grey", 0.9, 0.6), BOARD_180, METAL)
+)
+EXPOSED_SLAB = Construction("Exposed concrete slab", (HEAVY_CONCRETE_200, SCREED_50))
+
+# --- constructions of the concealed effects -------------------------------------------------
+# Dark facades of little insulation: the sun they absorb reaches the room (sol-air).
+DARK_PANEL = Construction(
+    "Dark metal panel 20mm", (METAL.surface("Metal dark", 0.9, 0.9), PUR_20, METAL)
+)
+DARK_CLADDING = Construction(
+    "Dark metal cladding uninsulated",
+    (METAL.surface("Metal dark", 0.9, 0.92), WALL_AIR_SPACE, GYPSUM_19),
+)
+# High-emissivity, pale, uninsulated roofs: long-wave loss to the sky, little sun.
+BARE_ROOF = Construction(
+    "Pale metal roof uninsulated",
+    (METAL.surface("Metal pale", 0.9, 0.3), WALL_AIR_SPACE, GYPSUM_19),
+)
+SINGLE_SKIN_ROOF = Construction(
+    "Pale single-skin metal roof", (METAL.surface("Metal pale", 0.9, 0.3),)
+)
+# Slabs on the ground: the soil below carries the ground's slow temperature.
+INSULATED_SLAB = Construction(
+    "Insulated slab on ground", (SOIL_1000, XPS_100, HEAVY_CONCRETE_100, SCREED_50)
+)
+BARE_SLAB = Construction("Uninsulated slab on ground", (SOIL_1000, HEAVY_CONCRETE_100, SCREED_50))
+
+
+def radiant_floor(below: Construction, screed_mm: int) -> Construction:
+    """The floor ``below`` with an electric mat under ``screed_mm`` of screed (the mat sits
+    after the layers of ``below``). [mm]"""
+    screed = Material(f"Cement screed {screed_mm}mm", screed_mm / 1000.0, 1.4, 2000.0, 1000.0)
+    return Construction(f"{below.name} radiant {screed_mm}mm", (*below.layers, screed))
+
+
+@dataclass(frozen=True)
+class Archetype:
+    """One building type. summary: plain words; sizes [m]; rows: zones per storey (south,
+    north); ``mass_per_floor``: internal-mass area per floor area [m²/m²]; sill / head: window
+    heights above the storey floor [m]; ``m2_per_person`` [m²]; lights [W/m²]; infiltration
+    [1/h]; setpoints [°C]; heated_hours: weekday hours of the occupied setpoint (civil time);
+    capacity_factor: heater size / design heat loss [-]."""
+
+    name: str
+    summary: str
+    zone_name: str
+    width: float
+    depth: float
+    storey_height: float
+    storeys: int
+    rows: int
+    wall: Construction
+    roof: Construction
+    floor: Construction
+    floor_boundary: str
+    intermediate_floor: Construction | None
+    partition: Construction | None
+    internal_mass: Construction
+    mass_per_floor: float
+    glazing: SimpleGlazing
+    sill: float
+    head: float
+    m2_per_person: float
+    lights_w_m2: float
+    infiltration_ach: float
+    occupied_setpoint: float
+    setback: float
+    heated_hours: tuple[int, int]
+    capacity_factor: float
+
+    @property
+    def floor_area(self) -> float:
+        return self.width * self.depth * self.storeys
+
+    @property
+    def volume(self) -> float:
+        return self.floor_area * self.storey_height
+
+
+LIGHT = Archetype(
+    name="light",
+    summary="Light timber-frame pavilion, 216 m², one zone",
+    zone_name="Pavilion",
+    width=12.0,
+    depth=18.0,
+    storey_height=3.0,
+    storeys=1,
+    rows=1,
+    wall=TIMBER_WALL,
+    roof=LIGHT_ROOF,
+    floor=CRAWL_FLOOR,
+    floor_boundary="Outdoors",
+    intermediate_floor=None,
+    partition=None,
+    internal_mass=PARTITION,
+    mass_per_floor=1.0,
+    glazing=SimpleGlazing("Double clear U2.7", 2.7, 0.70, 0.78),
+    sill=0.8,
+    head=2.4,
+    m2_per_person=12.0,
+    lights_w_m2=8.0,
+    infiltration_ach=0.4,
+    occupied_setpoint=21.0,
+    setback=15.0,
+    heated_hours=(6, 19),
+    capacity_factor=1.3,
+)
+HEAVY = Archetype(
+    name="heavy",
+    summary="Heavy two-storey masonry office, 576 m² in four zones",
+    zone_name="Office",
+    width=24.0,
+    depth=12.0,
+    storey_height=3.3,
+    storeys=2,
+    rows=2,
+    wall=MASONRY_WALL,
+    roof=CONCRETE_ROOF,
+    floor=CONCRETE_FLOOR,
+    floor_boundary="Adiabatic",
+    intermediate_floor=CONCRETE_FLOOR,
+    partition=BRICK_PARTITION,
+    internal_mass=BRICK_PARTITION,
+    mass_per_floor=0.6,
+    glazing=SimpleGlazing("Double low-e U1.4", 1.4, 0.55, 0.70),
+    sill=0.9,
+    head=2.5,
+    m2_per_person=10.0,
+    lights_w_m2=7.0,
+    infiltration_ach=0.3,
+    occupied_setpoint=20.0,
+    setback=16.0,
+    heated_hours=(5, 19),
+    capacity_factor=1.1,
+)
+OPEN_PLAN = Archetype(
+    name="open_plan",
+    summary="Steel-frame open-plan floor over an exposed concrete slab, 700 m², one zone",
+    zone_name="Open plan",
+    width=35.0,
+    depth=20.0,
+    storey_height=4.0,
+    storeys=1,
+    rows=1,
+    wall=PANEL_WALL,
+    roof=DECK_ROOF,
+    floor=EXPOSED_SLAB,
+    floor_boundary="Adiabatic",
+    intermediate_floor=None,
+    partition=None,
+    internal_mass=PARTITION,
+    mass_per_floor=0.3,
+    glazing=SimpleGlazing("Double low-e U1.8", 1.8, 0.60, 0.70),
+    sill=1.0,
+    head=3.2,
+    m2_per_person=12.0,
+    lights_w_m2=9.0,
+    infiltration_ach=0.3,
+    occupied_setpoint=21.0,
+    setback=16.0,
+    heated_hours=(6, 19),
+    capacity_factor=1.2,
+)
+ARCHETYPES = {a.name: a for a in (LIGHT, HEAVY, OPEN_PLAN)}
+
+
+@dataclass(frozen=True)
+class Calendar:
+    """Civil calendar of a site: IANA ``timezone``, EnergyPlus's daylight-saving rule
+    (``dst_start`` / ``dst_end``, e.g. "Last Sunday in March") and the holiday closure
+    (first day as (month, day), length in days) when the heating is off and nobody comes."""
+
+    timezone: str
+    dst_start: str
+    dst_end: str
+    holiday_start: tuple[int, int]
+    holiday_days: int
+
+    def objects(self) -> str:
+        """Daylight saving, the closure as holidays, the heating availability schedule."""
+        month, day = self.holiday_start
+        first = date(2017, month, day)
+        last = first + timedelta(days=self.holiday_days - 1)
+        if last.year == first.year:
+            spans = [(first - timedelta(days=1), 1), (last, 0), (date(2017, 12, 31), 1)]
+        else:
+            spans = [(last.replace(year=2017), 0), (first - timedelta(days=1), 1)]
+            spans.append((date(2017, 12, 31), 0))
+        fields: list[object] = ["Heating Availability", "OnOff"]
+        for until, on in spans:
+            fields += [f"Through: {until.month:02d}/{until.day:02d}", "For: AllDays"]
+            fields += ["Until: 24:00", on]
+        return "".join(
+            [
+                idf_object("RunPeriodControl:DaylightSavingTime", self.dst_start, self.dst_end),
+                idf_object(
+                    "RunPeriodControl:SpecialDays",
+                    "Holiday closure",
+                    f"{month}/{day}",
+                    self.holiday_days,
+                    "Holiday",
+                ),
+                idf_object("Schedule:Compact", *fields),
+            ]
+        )

