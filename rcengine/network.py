@@ -61,24 +61,31 @@ class Parameter:
 
 @dataclass(frozen=True)
 class Capacitor:
+    """The heat capacity of a node, C = factor · capacity. [J/K]"""
+
     node: str
-    capacity: Value  # C = factor · value [J/K]
+    capacity: Value
     factor: float = 1.0
 
 
 @dataclass(frozen=True)
 class Resistor:
+    """A resistance R = factor · resistance between two nodes, or a node and a prescribed
+    temperature. [K/W]"""
+
     a: str
     b: str
-    resistance: Value  # R = factor · value [K/W]
+    resistance: Value
     factor: float = 1.0
 
 
 @dataclass(frozen=True)
 class HeatInput:
+    """Heat q = factor · gain · u of the input signal u, into a node. [W]"""
+
     signal: str
     node: str
-    gain: Value = 1.0  # q = factor · gain · u [W]
+    gain: Value = 1.0
     factor: float = 1.0
 
 

@@ -152,7 +152,9 @@ class ParameterSet:
                 engine_version=data.get("engine_version", "unknown"),
                 created_at=data.get("created_at", ""),
             )
-        except (KeyError, TypeError, ValueError) as exc:
+        except KeyError as exc:
+            raise ModelError(f"invalid parameter file: {_missing_entry(data, exc)}") from exc
+        except (TypeError, ValueError) as exc:
             raise ModelError(f"invalid parameter file: {exc}") from exc
 
     def save(self, path: str | Path) -> None:
@@ -161,3 +163,16 @@ class ParameterSet:
     @classmethod
     def load(cls, path: str | Path) -> ParameterSet:
         return cls.from_dict(read_json(path, ModelError))
+
+
+def _missing_entry(data: object, exc: KeyError) -> str:
+    """What a parameter document lacks, and what the file probably is instead."""
+    found = "" if not isinstance(data, dict) else f"; found {sorted(data)[:8]}"
+    hint = (
+        " — this looks like a building description, not a parameter file written by "
+        "`rcengine fit`"
+        if isinstance(data, dict) and "location" in data and "network" not in data
+        else ""
+    )
+    needed = "a parameter file has model, network, parameters, building"
+    return f"no {exc.args[0]!r} entry ({needed}){found}{hint}"

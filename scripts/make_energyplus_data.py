@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `scripts.energyplus` importable
 
 from scripts.energyplus.cases import make_office, make_variants  # noqa: E402
-from scripts.energyplus.run import WEATHER, read_site  # noqa: E402
+from scripts.energyplus.run import WEATHER, add_out_option, read_site  # noqa: E402
 from scripts.energyplus.shoebox import CASES  # noqa: E402
 
 
@@ -31,12 +31,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--only", choices=["office", "variants", *case_names], help="regenerate only this part"
     )
-    parser.add_argument(
-        "--out",
-        type=Path,
-        default=ROOT / "data" / "energyplus",
-        help="output directory (default: data/energyplus)",
-    )
+    add_out_option(parser, "energyplus")
     args = parser.parse_args(argv)
 
     site = read_site(WEATHER)

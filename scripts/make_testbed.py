@@ -20,6 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `scripts.energyplus` importable
 
+from scripts.energyplus.run import add_out_option  # noqa: E402
 from scripts.energyplus.testbed import CASES, make_testbed  # noqa: E402
 
 
@@ -29,12 +30,7 @@ def main(argv: list[str] | None = None) -> None:
         "--only", nargs="+", choices=[c.name for c in CASES], help="regenerate only these cases"
     )
     parser.add_argument("--jobs", type=int, default=1, help="cases simulated at a time")
-    parser.add_argument(
-        "--out",
-        type=Path,
-        default=ROOT / "data" / "testbed",
-        help="output directory (default: data/testbed)",
-    )
+    add_out_option(parser, "testbed")
     args = parser.parse_args(argv)
     started = time.perf_counter()
     make_testbed(args.out, args.only, args.jobs)

@@ -172,6 +172,14 @@ def workdir(office, tmp_path, monkeypatch) -> Path:
     return tmp_path
 
 
+def predict_day(params: str):
+    """``predict`` of a day of the working folder's data with the parameter file ``params``."""
+    return invoke(
+        "predict", "data.csv", "--params", params, "--start", OFFICE_FORECAST_START,
+        "--hours", "24", "-o", "f.csv",
+    )  # fmt: skip
+
+
 def test_missing_data_file(workdir):
     result = invoke("fit", "nope.csv", "--building", "b.json", "--model", "basic", "-o", "p.json")
     assert result.exit_code != 0
@@ -180,10 +188,7 @@ def test_missing_data_file(workdir):
 
 
 def test_missing_params_file(workdir):
-    result = invoke(
-        "predict", "data.csv", "--params", "nope.json", "--start", OFFICE_FORECAST_START,
-        "--hours", "24", "-o", "f.csv",
-    )  # fmt: skip
+    result = predict_day("nope.json")
     assert result.exit_code != 0
     assert "'nope.json' does not exist" in result.output
 
@@ -212,10 +217,7 @@ def test_unknown_model_is_named(workdir):
 
 def test_invalid_params_file_is_named(workdir):
     Path("p.json").write_text("{not json")
-    result = invoke(
-        "predict", "data.csv", "--params", "p.json", "--start", OFFICE_FORECAST_START,
-        "--hours", "24", "-o", "f.csv",
-    )  # fmt: skip
+    result = predict_day("p.json")
     assert result.exit_code != 0
     assert "p.json: not valid JSON" in result.output
     assert not Path("f.csv").exists()

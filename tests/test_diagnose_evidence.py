@@ -14,7 +14,7 @@ from rcengine.diagnose.folds import FoldEvidence, rolling_folds
 from rcengine.diagnose.health import Health
 from rcengine.diagnose.html import render
 from rcengine.diagnose.report import Finding, confirm_on_folds, reject_implausible, verdict
-from rcengine.diagnose.selection import _winner
+from rcengine.diagnose.selection import MIN_HVAC_SHARE, _informative, _winner
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
 from tests.test_diagnose import _hidden_gain
 
@@ -86,6 +86,21 @@ def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
                      "Europe/Rome")
     assert steady.accepted and "across folds: helps in 3 of 3 folds" in steady.reason
     assert steady.folds["helped"] == 3 and steady.folds["pooled_rmse_test_before"] == 1.0
+
+
+def test_a_fold_trained_without_heating_but_tested_with_it_is_left_out():
+    times = pd.date_range("2016-10-01", "2017-01-01", freq="1h", tz="UTC")
+    folds = rolling_folds(times, "Europe/Rome", 28, 14, 3)
+    # Free-floating until 1 November, then heated: the first fold trains on October alone.
+    heating = np.where(times < pd.Timestamp("2016-11-01", tz="UTC"), 0.0, 2000.0)
+    frame = pd.DataFrame({"q_hvac": heating}, index=times)
+    kept, left_out = _informative(frame, folds)
+    assert left_out == [folds[0]] and kept == folds[1:]
+    # A trickle of heating in training is still too little to identify its effect.
+    trickle = frame.assign(q_hvac=np.maximum(heating, 0.5 * MIN_HVAC_SHARE * 2000.0))
+    assert _informative(trickle, folds)[1] == [folds[0]]
+    assert _informative(frame.assign(q_hvac=0.0), folds) == (folds, [])
+    assert _informative(frame.drop(columns="q_hvac"), folds) == (folds, [])
 
 
 def test_of_two_passing_candidates_the_head_to_head_winner_is_taken_and_the_other_reported():

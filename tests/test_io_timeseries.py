@@ -92,13 +92,20 @@ def test_column_named_twice_is_an_error():
 
 
 # --- time -------------------------------------------------------------------------------------
-def test_unparseable_time_names_row_text_and_line():
-    rows = good_rows(14)
-    rows[12] = "09/01/2017 09:00,20,3,0,0"
+def time_problem(n: int, row: int, text: str) -> str:
+    """The message of the one problem of ``n`` good rows whose row ``row`` has the time ``text``,
+    which must be that row's time."""
+    rows = good_rows(n)
+    rows[row] = f"{text},20,3,0,0"
     (problem,) = problems_of(csv(*rows))
-    assert (problem.row, problem.column) == (12, "time")
-    assert "'09/01/2017 09:00'" in problem.message
-    assert "line 14 of the file" in problem.message  # header is line 1, row 0 line 2
+    assert (problem.row, problem.column) == (row, "time")
+    return problem.message
+
+
+def test_unparseable_time_names_row_text_and_line():
+    message = time_problem(14, 12, "09/01/2017 09:00")
+    assert "'09/01/2017 09:00'" in message
+    assert "line 14 of the file" in message  # header is line 1, row 0 line 2
 
 
 def test_time_without_offset_is_rejected():
@@ -110,9 +117,7 @@ def test_time_without_offset_is_rejected():
 
 
 def test_impossible_date_is_rejected():
-    (problem,) = problems_of(csv("2017-02-30T00:00:00+01:00,20,3,0,0"))
-    assert (problem.row, problem.column) == (0, "time")
-    assert "no such time" in problem.message
+    assert "no such time" in time_problem(1, 0, "2017-02-30T00:00:00+01:00")
 
 
 def test_duplicate_timestamp_names_both_rows():

@@ -195,8 +195,9 @@ def test_physical_units_reach_the_network_scaled_by_the_building(gain_context):
 
 
 def test_seasonal_ground_temperature_by_hand():
-    """t_out = 12 − 9·cos(2π(t − 15 Jan)/year) + a daily swing: the soil one penetration depth
-    down has the 12 °C mean, 9/e of the swing and its minimum a radian (58.1 days) later."""
+    """t_out = 12 − 9·cos(2π(t − 15 Jan)/year) + a daily swing: the soil under a slab has the
+    12 °C mean and its minimum a month later (z/δ = 2π/12 = 0.524 rad), its swing damped to
+    9·e^(−0.524) = 5.33 K."""
     times = pd.date_range("2017-01-01", "2017-12-31 23:00", freq="h", tz="UTC")
     coldest = pd.Timestamp("2017-01-16", tz="UTC")
     phase = 2 * np.pi * (times - coldest).total_seconds().to_numpy() / YEAR_S
@@ -205,12 +206,14 @@ def test_seasonal_ground_temperature_by_hand():
     assert cycle.mean == pytest.approx(12.0, abs=0.01)
     assert cycle.amplitude == pytest.approx(9.0, abs=0.01)
     ground = seasonal_ground_temperature(times, t_out, 45.0)
-    lag = YEAR_S / (2 * np.pi)
-    soil_extremes = [coldest + pd.Timedelta(seconds=lag + s) for s in (0.0, YEAR_S / 2)]
+    swing = 9.0 * np.exp(-2 * np.pi / 12)
+    assert swing == pytest.approx(5.33, abs=0.005)
+    soil_extremes = [coldest + pd.Timedelta(days=d) for d in (365.2425 / 12, 365.2425 * 7 / 12)]
     coldest_soil, warmest_soil = times.get_indexer(soil_extremes, method="nearest")
-    assert ground[coldest_soil] == pytest.approx(12.0 - 9.0 / np.e, abs=0.01)
-    assert ground[warmest_soil] == pytest.approx(12.0 + 9.0 / np.e, abs=0.01)
-    assert ground.min() == pytest.approx(12.0 - 9.0 / np.e, abs=0.01)
+    assert ground[coldest_soil] == pytest.approx(12.0 - swing, abs=0.01)
+    assert ground[warmest_soil] == pytest.approx(12.0 + swing, abs=0.01)
+    assert ground.min() == pytest.approx(12.0 - swing, abs=0.01)
+    assert times[np.argmin(ground)] == times[coldest_soil]
     # the southern hemisphere's coldest day is half a year later
     assert annual_cycle(times, -t_out, -33.9).amplitude == pytest.approx(9.0, abs=0.01)
 

@@ -4,6 +4,11 @@ Each candidate builds, from the data and the building JSON, what the model would
 one missing effect — a new input with a bounded gain, a new node, or a new resistance to a new
 boundary temperature — or says why it cannot be built (its inputs are missing). The effect ids are
 the contract's vocabulary (CONTRACT.md §3).
+
+Each enters where the physics puts it and is parameterised in physical units (g-value,
+absorptance, air changes per hour, W/m² of floor, floor U-value, capacity per m²), searched
+``plausibility.SEARCH_MARGIN`` past the range a real building allows, so that
+``plausibility.assess`` can tell a fit that needs an impossible magnitude.
 """
 
 from __future__ import annotations
@@ -380,13 +385,15 @@ class LearntSchedule:
         return f"{describe(self.schedule)}{clock}"
 
 
-def _learnt_schedule(ctx: Context, node: str, per_unit: np.ndarray) -> LearntSchedule:
-    """0/1 weekly schedule of a missing input ``θ · schedule(t) · per_unit(t)`` at ``node``.
+def _learnt_schedule(
+    ctx: Context, node: str, per_unit: np.ndarray, saturated: np.ndarray
+) -> LearntSchedule:
+    """0/1 weekly schedule of a missing input ``θ · schedule(t) · per_unit(t)`` at ``node``,
+    learnt outside the rows where the heater is ``saturated`` (see ``_schedule_on_clock``).
 
     Learnt on both clocks a building may keep (civil time or standard time all year) unless the
     model already plays a schedule on one; the clock whose schedule explains more is kept.
     """
-    saturated = heater_saturated(ctx.train)
     learnt = [
         _schedule_on_clock(ctx, saturated, node, per_unit, clock) for clock in _clocks(ctx)
     ]
@@ -398,8 +405,8 @@ def heater_saturated(frame: pd.DataFrame) -> np.ndarray:
     largest output, unless that is how the heater always runs (``ON_OFF_SHARE``).
 
     A heater at capacity leaves the room under its setpoint in a pattern that repeats every cold
-    morning; its recovery is metered physics, not a schedule, and learning a schedule from those
-    rows would name it a missing gain or loss.
+    morning; its recovery is metered physics, not a schedule, and learning a schedule of missing
+    heat from those rows would name it a missing gain.
     """
     if Q_HVAC not in frame.columns:
         return np.zeros(len(frame), dtype=bool)
@@ -511,7 +518,9 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     if VENT_LOSS in ctx.network.signals:
         return Skipped(effect, "the model already has a ventilation schedule")
     outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - T_REF_C
-    learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess)
+    # A missing loss may itself drive the heater to its capacity: those rows are evidence.
+    saturated = np.zeros(len(ctx.data), dtype=bool)
+    learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess, saturated)
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
     ach_vent = Parameter(
@@ -533,7 +542,10 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     effect = "unmetered_gains"
     if SCHED_GAINS in ctx.network.signals:
         return Skipped(effect, "the model already has an unmetered-gain schedule")
-    learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)))
+    # A missing gain would lighten the heater's load; a heater at capacity is evidence of the
+    # opposite, and its recovery (metered) must not be learnt as a gain.
+    saturated = heater_saturated(ctx.train)
+    learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)), saturated)
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of missing heat")
     floor = ctx.building.floor_area

@@ -14,6 +14,7 @@ from rcengine.dataset import Dataset
 from rcengine.diagnose.folds import Fold
 from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
+from rcengine.estimation.presets import EstimatorSettings
 from rcengine.exceptions import ConvergenceWarning
 from rcengine.kalman import kalman_filter
 from rcengine.metrics import rmse
@@ -118,7 +119,7 @@ def fit_model(
     network: RCNetwork,
     options: SignalOptions,
     split: Split,
-    preset: str,
+    preset: str | EstimatorSettings,
     random_state: int,
     warm_start: list[dict[str, float]] | None = None,
 ) -> Fit:
@@ -164,7 +165,7 @@ class FitJob:
     network: RCNetwork
     options: SignalOptions
     split: Split
-    preset: str
+    preset: str | EstimatorSettings
     random_state: int
     warm_start: list[dict[str, float]] | None = None
 

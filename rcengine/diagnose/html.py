@@ -12,6 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+import pandas as pd
 
 from rcengine.diagnose.fitting import Fit
 from rcengine.diagnose.locate import DAYS, hour_weekday
@@ -191,10 +192,27 @@ def _folds_table(finding: dict) -> str:
     )
 
 
+def _no_folds(d: dict) -> str:
+    if d["evidence"]["method"] == "split":
+        return "<p>Judged on the single split alone (no folds asked for, or a short record).</p>"
+    return "<p>No candidate passed the single split, so none was refitted on the folds.</p>"
+
+
+def local_day(instant: str, timezone: str) -> str:
+    """The date of an ISO 8601 instant in ``timezone`` (a UTC text cut to 10 characters gives
+    the day before for a local midnight east of Greenwich)."""
+    return pd.Timestamp(instant).tz_convert(timezone).strftime("%Y-%m-%d")
+
+
 def render(report: Report) -> str:
     """The report as a standalone HTML page."""
     d = report.to_dict()
     esc = html.escape
+    zone = report.building.location.timezone
+
+    def day(instant: str) -> str:
+        return local_day(instant, zone)
+
     rows = "".join(
         f"<tr><td>{esc(f['effect'])}</td>"
         + ("<td class=ok>accepted</td>" if f["accepted"] else "<td class=no>rejected</td>")
@@ -210,7 +228,10 @@ def render(report: Report) -> str:
         f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_png(evidence_figure(report, f))}"
         for f in report.accepted
     )
-    folds = "".join(_folds_table(f) for f in d["findings"])
+    folds = "".join(_folds_table(f) for f in d["findings"]) + "".join(
+        f"<p>Fold testing {esc(f['test'])} left out: {esc(f['reason'])}.</p>"
+        for f in d["evidence"]["left_out"]
+    )
     white = d["whiteness"]
     return f"""<!doctype html><html><head><meta charset="utf-8">
 <title>Mismatch diagnosis — {esc(report.building.name)}</title><style>{_STYLE}</style></head><body>
@@ -219,8 +240,8 @@ def render(report: Report) -> str:
 <p>Baseline <b>{esc(report.model)}</b>: train RMSE {d["baseline"]["rmse_train"]:.3f} K,
 test RMSE {d["baseline"]["rmse_test"]:.3f} K. Final <b>{esc(d["final"]["model"])}</b>:
 train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
-Training {esc(d["periods"]["train"][0][:10])} – {esc(d["periods"]["train"][1][:10])},
-test until {esc(d["periods"]["test"][1][:10])}.</p>
+Training {esc(day(d["periods"]["train"][0]))} – {esc(day(d["periods"]["train"][1]))},
+test until {esc(day(d["periods"]["test"][1]))}.</p>
 <p>Where and when: {esc(d["mismatch"]["summary"])}.</p></div>
 <h2>Measured vs predicted</h2>{_png(timeseries_figure(report))}
 <h2>Where the errors concentrate</h2>{_png(heatmaps_figure(report))}
@@ -228,7 +249,7 @@ test until {esc(d["periods"]["test"][1][:10])}.</p>
 <h2>Findings</h2><table><tr><th>effect</th><th>verdict</th><th>screening</th>
 <th>test RMSE before [K]</th><th>after [K]</th><th>ΔBIC</th><th>reason</th></tr>{rows}</table>
 <h2>Evidence for accepted findings</h2>{evidence or "<p>None accepted.</p>"}
-<h2>Evidence across rolling folds</h2>{folds or "<p>Judged on the single split alone.</p>"}
+<h2>Evidence across rolling folds</h2>{folds or _no_folds(d)}
 <h2>Residual whiteness (Ljung–Box, hourly one-step-ahead errors, 24 lags)</h2>
 <p>Before: Q = {white["baseline"]["q"]:.0f},
 lag-1 h autocorrelation {white["baseline"]["rho_1h"]:.2f};

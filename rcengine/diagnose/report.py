@@ -341,7 +341,8 @@ def _signal_of(finding: Finding, orientation: str) -> str:
 class Report:
     """The diagnosis: ``health`` and ``quality`` of the base model as given, ``repair`` the
     outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
-    extension had to help across (none: judged on the single split)."""
+    extension had to help across (none: judged on the single split), ``folds_left_out`` those
+    whose training window barely ran the HVAC its test window ran."""
 
     building: Building
     model: str
@@ -357,6 +358,7 @@ class Report:
     quality: FitQuality | None = None
     repair: dict | None = None
     folds: list[Fold] = field(default_factory=list)
+    folds_left_out: list[Fold] = field(default_factory=list)
 
     @property
     def accepted(self) -> list[Finding]:
@@ -394,6 +396,13 @@ class Report:
                 "folds": [
                     {"train_start": f.train_start.tz_convert(tz).isoformat(), "test": f.label(tz)}
                     for f in self.folds
+                ],
+                "left_out": [
+                    {
+                        "test": f.label(tz),
+                        "reason": "its training window barely ran the HVAC its test window ran",
+                    }
+                    for f in self.folds_left_out
                 ],
             },
             "skipped": self.skipped,

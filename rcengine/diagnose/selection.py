@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from rcengine.building import Building
-from rcengine.columns import T_IN
+from rcengine.columns import Q_HVAC, T_IN
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped
 from rcengine.diagnose.fitting import (
     Fit,
@@ -57,6 +57,12 @@ from rcengine.models import get_model
 from rcengine.network import RCNetwork
 from rcengine.parallel import one_blas_thread
 from rcengine.signals import SignalOptions
+
+# A fold whose training window barely heats (or cools) cannot identify the model's response to
+# the HVAC; when its test window does heat, its test error measures that extrapolation, not the
+# candidate (a season's first fold, free-floating until the heating starts, is the usual case).
+# Such a fold — mean |q_hvac| in training below this share of the test window's — is left out. [-]
+MIN_HVAC_SHARE = 0.1
 
 
 @dataclass(frozen=True)
@@ -133,10 +139,10 @@ def _diagnose(
     started = time.perf_counter()
     timezone = building.location.timezone
     boundary = split_time(frame, settings.train_fraction, timezone)
-    folds = []
+    folds, left_out = [], []
     if settings.evidence == "folds":
         days = (settings.fold_train_days, settings.fold_test_days, settings.max_folds)
-        folds = rolling_folds(frame.index, timezone, *days)
+        folds, left_out = _informative(frame, rolling_folds(frame.index, timezone, *days))
     say = progress or (lambda message: None)
     problem = Problem(frame, building, boundary, settings, say, folds)
     problem.say(f"fitting {model} on the training period (until {boundary.date()})")
@@ -168,7 +174,22 @@ def _diagnose(
         quality,
         state.repair,
         folds,
+        left_out,
     )
+
+
+def _informative(frame: pd.DataFrame, folds: list[Fold]) -> tuple[list[Fold], list[Fold]]:
+    """The folds whose training window runs the HVAC enough to identify its effect on what the
+    test window asks (``MIN_HVAC_SHARE``), and the folds left out."""
+    if Q_HVAC not in frame.columns:
+        return folds, []
+    q = frame[Q_HVAC].abs()
+    kept, left_out = [], []
+    for fold in folds:
+        train = q[(q.index >= fold.train_start) & (q.index < fold.test_start)].mean()
+        test = q[(q.index >= fold.test_start) & (q.index < fold.test_end)].mean()
+        (left_out if train < MIN_HVAC_SHARE * test else kept).append(fold)
+    return kept, left_out
 
 
 def _baseline(problem: Problem, model: str) -> Fit:

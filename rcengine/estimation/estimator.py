@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import KW_ONLY, dataclass, replace
 
 import numpy as np
 import scipy.optimize
@@ -74,6 +74,9 @@ def search(
     return ga_result, gps_result
 
 
+# The settings are kept as given (no equality or repr of its own: an estimator is a thing that
+# is fitted, not a value).
+@dataclass(eq=False, repr=False)
 class Estimator:
     """Calibrate an RC network's parameters on measured data.
 
@@ -109,34 +112,19 @@ class Estimator:
         with standard errors, correlations and residual checks, or None.
     """
 
-    def __init__(
-        self,
-        network: RCNetwork | CompiledNetwork,
-        *,
-        preset: str | EstimatorSettings = "default",
-        ga: GASettings | None = None,
-        gps: GPSSettings | None = None,
-        cost: str = "mse",
-        known: Mapping[str, float] | None = None,
-        bounds: Mapping[str, tuple[float, float]] | None = None,
-        polish: bool | None = None,
-        random_state: int | np.random.Generator | None = None,
-        warm_start: list[Mapping[str, float]] | None = None,
-        criterion: str = "output_error",
-        initial: str = "diffuse",
-    ):
-        self.network = network
-        self.preset = preset
-        self.ga = ga
-        self.gps = gps
-        self.cost = cost
-        self.known = known
-        self.bounds = bounds
-        self.polish = polish
-        self.random_state = random_state
-        self.warm_start = warm_start
-        self.criterion = criterion
-        self.initial = initial
+    network: RCNetwork | CompiledNetwork
+    _: KW_ONLY
+    preset: str | EstimatorSettings = "default"
+    ga: GASettings | None = None
+    gps: GPSSettings | None = None
+    cost: str = "mse"
+    known: Mapping[str, float] | None = None
+    bounds: Mapping[str, tuple[float, float]] | None = None
+    polish: bool | None = None
+    random_state: int | np.random.Generator | None = None
+    warm_start: list[Mapping[str, float]] | None = None
+    criterion: str = "output_error"
+    initial: str = "diffuse"
 
     @property
     def compiled(self) -> CompiledNetwork:

@@ -70,6 +70,7 @@ _WITHOUT_OFFSET = re.compile(rf"^\s*{_LOCAL_TIME}\s*$")
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+\s*$")
 _NS_PER_S = 1_000_000_000
 _NAT = np.iinfo(np.int64).min  # NaT as int64 nanoseconds
+_NS_MIN, _NS_MAX = pd.Timestamp.min.tz_localize("UTC"), pd.Timestamp.max.tz_localize("UTC")
 
 
 @dataclass
@@ -282,20 +283,31 @@ def _parse_times(cells: pd.Series, problems: _Problems) -> tuple[np.ndarray, pd.
     no_offset = np.zeros_like(ok)
     suspect = np.flatnonzero(~ok & ~empty)
     no_offset[suspect] = text.iloc[suspect].str.match(_WITHOUT_OFFSET).to_numpy(dtype=bool)
-    parsed = pd.to_datetime(text.where(ok), format="ISO8601", utc=True, errors="coerce")
-    ns = pd.DatetimeIndex(parsed).as_unit("ns").asi8.copy()
+    parsed = pd.DatetimeIndex(
+        pd.to_datetime(text.where(ok), format="ISO8601", utc=True, errors="coerce")
+    )
+    # pandas parses years 1–9999 at a coarser unit; nanoseconds reach 1677–2262 only.
+    outside = ok & ~np.asarray(parsed.isna() | ((parsed >= _NS_MIN) & (parsed <= _NS_MAX)))
+    problems.add_rows(
+        np.flatnonzero(outside),
+        TIME,
+        lambda r: f"time {text[r]!r} is outside the supported range 1677-09-22 … 2262-04-11",
+    )
+    ok = ok & ~outside
+    ns = parsed.where(~outside).as_unit("ns").asi8.copy()
     invalid = ok & (ns == _NAT)
     problems.add_rows(np.flatnonzero(empty), TIME, lambda r: "time is empty")
+    lacking = np.flatnonzero(no_offset)
+    if lacking.size:  # one problem for all: usually every row of a file lacks it
+        more = f" (nor have {lacking.size - 1} later rows)" if lacking.size > 1 else ""
+        problems.add(
+            int(lacking[0]),
+            TIME,
+            f"time {text[lacking[0]]!r} has no UTC offset{more}; the contract requires one, "
+            f"e.g. '{_EXAMPLE_TIME}' ('Z' for UTC)",
+        )
     problems.add_rows(
-        np.flatnonzero(no_offset),
-        TIME,
-        lambda r: (
-            f"time {text[r]!r} has no UTC offset; the contract requires one, "
-            f"e.g. '{_EXAMPLE_TIME}' ('Z' for UTC)"
-        ),
-    )
-    problems.add_rows(
-        np.flatnonzero(~ok & ~empty & ~no_offset),
+        np.flatnonzero(~ok & ~empty & ~no_offset & ~outside),
         TIME,
         lambda r: (
             f"unparseable time {text[r]!r}; expected ISO 8601 with a UTC offset, "
@@ -395,7 +407,7 @@ def _parse_numbers(cells: pd.Series, name: str, problems: _Problems) -> np.ndarr
     problems.add_rows(
         np.flatnonzero(np.isnan(numbers) & ~blank),
         name,
-        lambda r: f"not a number: {cells.iloc[r]!r}{_decimal_hint(cells.iloc[r])}",
+        lambda r: f"not a number: {_shown(cells.iloc[r])!r}{_decimal_hint(cells.iloc[r])}",
     )
     if name in FILLED_EVERY_ROW:
         problems.add_rows(
@@ -417,7 +429,7 @@ def _check_range(numbers: np.ndarray, name: str, problems: _Problems) -> None:
             problems.add(
                 None,
                 name,
-                f"column '{name}' looks like Kelvin (median {median:.1f}); the contract expects "
+                f"looks like Kelvin (median {median:.1f}); the contract expects "
                 f"°C — subtract {ZERO_CELSIUS_K}",
             )
             return
@@ -470,6 +482,11 @@ def _as_text(cells: pd.Series) -> pd.Series:
     if pd.api.types.is_string_dtype(text.dtype) and text.dtype != object:
         return text
     return text.map(lambda v: v if isinstance(v, str) or pd.isna(v) else str(v), na_action="ignore")
+
+
+def _shown(cell: object) -> object:
+    """A cell as its user wrote it: ``True``, not numpy's ``np.True_``."""
+    return cell.item() if isinstance(cell, np.generic) else cell
 
 
 def _decimal_hint(cell: object) -> str:

@@ -27,10 +27,12 @@ YEAR_S = 365.2425 * 86400.0
 # J/(m³K): ISO 13370:2017 Table 7 (δ = 3.2 m; 2.2 m in clay, 4.2 m in rock); the standard's
 # soil when the soil is unknown. [m]
 SOIL_PENETRATION_DEPTH_M = 3.2
-# Depth of soil between a slab and the undisturbed ground it exchanges with: one penetration depth
-# (the scale of ISO 13370's periodic floor coefficients), damping the outdoor swing to 1/e and
-# lagging it by a radian (≈ 58 days). [m]
-GROUND_DEPTH_M = SOIL_PENETRATION_DEPTH_M
+# Lag of a slab floor's ground heat flow behind the outdoor annual cycle: about a month (the phase
+# shift β of ISO 13370's periodic method for slab-on-ground floors, 0.7–1 month). [s]
+GROUND_LAG_S = YEAR_S / 12.0
+# The depth at which the annual wave lags by GROUND_LAG_S, z = δ·2π·lag/year (≈ 1.7 m; its swing
+# there is damped to e^(−z/δ) ≈ 0.59). [m]
+GROUND_DEPTH_M = SOIL_PENETRATION_DEPTH_M * 2.0 * np.pi * GROUND_LAG_S / YEAR_S
 # Coldest day of the outdoor annual cycle: about 25 days after the winter solstice in mid-latitude
 # climates (day of year, northern hemisphere; half a year later in the southern). [d]
 COLDEST_DAY_OF_YEAR = 15.0

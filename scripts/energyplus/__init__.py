@@ -4,8 +4,9 @@ Modules, lowest first:
 
 - ``library``: materials (EnergyPlus's ASHRAE 2005 HOF dataset values), constructions of thesis
   Table 2.1, weekly office schedules — values only.
-- ``idf``: IDF text — objects, rectangular geometry, the shared header (run period, site,
-  schedules, outputs).
+- ``geometry``: zone boxes and vertical rectangles (walls, windows) in world coordinates.
+- ``idf``: IDF text — objects, surfaces, the shared header (run period, site, schedules,
+  outputs).
 - ``zones``: zone-level objects — gains, infiltration, ventilation, ideal-loads heating.
 - ``office``: the three-zone reference office of thesis §2.4.1, with its physics checks.
 - ``shoebox``: the single-zone family, one switch per effect, and its ``CASES``.

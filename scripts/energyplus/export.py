@@ -13,24 +13,20 @@ import pandas as pd
 from rcengine.building import Building
 from rcengine.io.energyplus import read_eplusout, read_rates, write_contract_csv
 
-from .idf import RunPeriod, SiteInfo, VerticalRect
+from .geometry import VerticalRect
+from .idf import RunPeriod, SiteInfo
 from .run import WEATHER, run_energyplus
 
 TIMEZONE = "Europe/Rome"
 
 
 def simulate(
-    idf_text: str,
-    site: SiteInfo,
-    period: RunPeriod,
-    zones: Mapping[str, float] | None = None,
-    epw: Path = WEATHER,
-    timezone: str | None = None,
+    idf_text: str, site: SiteInfo, period: RunPeriod, zones: Mapping[str, float] | None = None
 ) -> pd.DataFrame:
-    """Run EnergyPlus and return the contract frame of exactly ``period`` (UTC index); the
-    period's days are local civil days of ``timezone`` (IANA) if given, else standard-time
-    days of the site."""
-    return simulate_with_rates(idf_text, site, period, zones, epw, timezone)[0]
+    """Run EnergyPlus on the Torino weather and return the contract frame of exactly ``period``
+    (UTC index), standard-time days of the site (``simulate_with_rates`` for another weather or
+    civil days)."""
+    return simulate_with_rates(idf_text, site, period, zones)[0]
 
 
 def simulate_with_rates(
@@ -42,7 +38,9 @@ def simulate_with_rates(
     timezone: str | None = None,
     rates: Iterable[str] = (),
 ) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
-    """``simulate``, and each variable of ``rates`` that the run reports, one column per key
+    """Run EnergyPlus on the weather ``epw``; the contract frame of exactly ``period`` (UTC
+    index), whose days are local civil days of ``timezone`` (IANA) if given, else standard-time
+    days of the site, and each variable of ``rates`` that the run reports, one column per key
     (``read_rates``), on the same rows."""
     with tempfile.TemporaryDirectory(prefix="eplus-") as tmp:
         csv = run_energyplus(idf_text, Path(tmp), epw)

@@ -41,14 +41,6 @@ class Material:
 
 
 @dataclass(frozen=True)
-class AirGap:
-    """A resistance-only layer. resistance [m²·K/W]"""
-
-    name: str
-    resistance: float
-
-
-@dataclass(frozen=True)
 class Glazing:
     """A glass pane, spectral averages. thickness [m], conductivity [W/(m·K)]."""
 
@@ -64,7 +56,8 @@ class Glazing:
 
 @dataclass(frozen=True)
 class SimpleGlazing:
-    """A whole glazing unit by its centre-of-glass figures (EnergyPlus's simple glazing model).
+    """A whole glazing unit by its centre-of-glass figures (EnergyPlus's simple glazing model,
+    ``WindowMaterial:SimpleGlazingSystem``, whose fields these are, in its order).
 
     u_factor: with films [W/(m²·K)]; shgc: solar heat gain coefficient at normal incidence [-];
     visible_transmittance [-].
@@ -83,6 +76,14 @@ class Gas:
     name: str
     thickness: float
     gas: str = "Air"
+
+
+@dataclass(frozen=True)
+class AirGap:
+    """A resistance-only layer. resistance [m²·K/W]"""
+
+    name: str
+    resistance: float
 
 
 Layer = Material | AirGap | Glazing | SimpleGlazing | Gas
@@ -144,39 +145,26 @@ class WeekSchedule:
 
 OFF_DAY: DayProfile = (("24:00", 0.0),)
 
+
+def day_profile(until: tuple[str, ...], values: tuple[float, ...]) -> DayProfile:
+    """A day as its "HH:MM" ends of periods (the last 24:00) and each period's value."""
+    return tuple(zip(until, values, strict=True))
+
+
 OFFICE_OCCUPANCY = WeekSchedule(
-    weekday=(
-        ("06:00", 0.0),
-        ("07:00", 0.1),
-        ("08:00", 0.2),
-        ("12:00", 0.95),
-        ("13:00", 0.5),
-        ("17:00", 0.95),
-        ("18:00", 0.3),
-        ("22:00", 0.1),
-        ("24:00", 0.05),
+    weekday=day_profile(
+        ("06:00", "07:00", "08:00", "12:00", "13:00", "17:00", "18:00", "22:00", "24:00"),
+        (0.0, 0.1, 0.2, 0.95, 0.5, 0.95, 0.3, 0.1, 0.05),
     ),
-    saturday=(
-        ("06:00", 0.0),
-        ("08:00", 0.1),
-        ("12:00", 0.3),
-        ("17:00", 0.1),
-        ("19:00", 0.05),
-        ("24:00", 0.0),
+    saturday=day_profile(
+        ("06:00", "08:00", "12:00", "17:00", "19:00", "24:00"), (0.0, 0.1, 0.3, 0.1, 0.05, 0.0)
     ),
     sunday=OFF_DAY,
 )
 OFFICE_LIGHTING = WeekSchedule(
-    weekday=(
-        ("05:00", 0.05),
-        ("07:00", 0.1),
-        ("08:00", 0.3),
-        ("17:00", 0.9),
-        ("18:00", 0.5),
-        ("20:00", 0.3),
-        ("22:00", 0.2),
-        ("23:00", 0.1),
-        ("24:00", 0.05),
+    weekday=day_profile(
+        ("05:00", "07:00", "08:00", "17:00", "18:00", "20:00", "22:00", "23:00", "24:00"),
+        (0.05, 0.1, 0.3, 0.9, 0.5, 0.3, 0.2, 0.1, 0.05),
     ),
     saturday=(("06:00", 0.05), ("08:00", 0.1), ("12:00", 0.3), ("17:00", 0.15), ("24:00", 0.05)),
     sunday=OFF_DAY,

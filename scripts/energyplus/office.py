@@ -45,12 +45,10 @@ from dataclasses import dataclass
 from datetime import date
 
 from . import zones
+from .geometry import SIDES, Box, VerticalRect
 from .idf import (
-    SIDES,
-    Box,
     RunPeriod,
     SiteInfo,
-    VerticalRect,
     building_surface,
     constant_schedule,
     header,

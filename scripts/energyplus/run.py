@@ -6,6 +6,7 @@ without its execute bit in the wheel — is never needed.
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 from pathlib import Path
 
@@ -13,6 +14,16 @@ from .idf import SiteInfo
 
 ROOT = Path(__file__).resolve().parents[2]
 WEATHER = ROOT.parent / "shared" / "data" / "weather" / "ITA_Torino.160590_IWEC.epw"
+
+
+def add_out_option(parser: argparse.ArgumentParser, folder: str) -> None:
+    """The generators' ``--out``: where to write, by default ``data/<folder>`` of the repo."""
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=ROOT / "data" / folder,
+        help=f"output directory (default: data/{folder})",
+    )
 
 
 def energyplus_binary() -> Path:

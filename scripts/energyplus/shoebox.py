@@ -41,12 +41,11 @@ from dataclasses import dataclass, field, replace
 import pandas as pd
 
 from . import zones
+from .geometry import SIDES, Box, VerticalRect
 from .idf import (
-    SIDES,
-    Box,
     RunPeriod,
     SiteInfo,
-    VerticalRect,
+    building_ground_temperatures,
     building_surface,
     constant_schedule,
     header,
@@ -77,6 +76,7 @@ from .library import (
     Glazing,
     Material,
     WeekSchedule,
+    day_profile,
     heating_availability,
 )
 
@@ -110,14 +110,9 @@ SUN_BLOCKING_PANE = Glazing("Sun-blocking 3MM", 0.003, 0.0, 0.92, 0.0, 0.92, 0.8
 WINDOW_NO_SUN = Construction("Double 3mm/13mm air no sun", (SUN_BLOCKING_PANE, AIR_13MM, CLEAR_3MM))
 
 OFFICE_EQUIPMENT = WeekSchedule(
-    weekday=(
-        ("07:00", 0.2),
-        ("08:00", 0.5),
-        ("12:00", 0.9),
-        ("13:00", 0.7),
-        ("17:00", 0.9),
-        ("19:00", 0.5),
-        ("24:00", 0.2),
+    weekday=day_profile(
+        ("07:00", "08:00", "12:00", "13:00", "17:00", "19:00", "24:00"),
+        (0.2, 0.5, 0.9, 0.7, 0.9, 0.5, 0.2),
     ),
     saturday=(("24:00", 0.2),),
     sunday=(("24:00", 0.2),),
@@ -279,11 +274,7 @@ class Shoebox:
                 zones.electric_equipment(ZONE, self.unmetered_w_m2, "Equipment"),
             ]
         if self.ground_floor:
-            # The EPW header's 4 m undisturbed soil temperatures: under a building the ground
-            # is steadier than the surface soil.
-            out.append(
-                idf_object("Site:GroundTemperature:BuildingSurface", *site.ground_temperatures[4.0])
-            )
+            out.append(building_ground_temperatures(site))
         if self.heavy_mass_area > 0.0:
             out.append(zones.internal_mass(ZONE, HEAVY_MASS.name, self.heavy_mass_area, "Concrete"))
         if self.sky_at_air_temperature:

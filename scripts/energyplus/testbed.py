@@ -148,11 +148,13 @@ class Effect:
     reference_description: str
 
 
-def _outer_absorptance(c: Construction) -> float:
+def _sun_and_u(c: Construction, r_si: float) -> str:
+    """The solar absorptance of the outer layer of ``c`` and its U-value with films (inside
+    film ``r_si``), as an effect's description quotes them."""
     outer = c.layers[0]
     if not isinstance(outer, Material):
         raise TypeError(f"{c.name}: the outer layer must be a material")
-    return outer.solar_absorptance
+    return f"solar absorptance {outer.solar_absorptance:.2f}, U = {u_value(c, r_si):.2f} W/(m²·K)"
 
 
 def window_solar(
@@ -173,11 +175,9 @@ def window_solar(
 
 
 def opaque_solar(walls: Construction) -> Effect:
-    u = u_value(walls, R_SI_WALL)
     return Effect(
         "opaque_solar_gains",
-        f"Dark, weakly insulated facades: {walls.name} (solar absorptance "
-        f"{_outer_absorptance(walls):.2f}, U = {u:.2f} W/(m²·K)).",
+        f"Dark, weakly insulated facades: {walls.name} ({_sun_and_u(walls, R_SI_WALL)}).",
         {"dark_walls": walls},
         {"wall_sun": False},
         "the same facades absorbing no sun",
@@ -228,11 +228,10 @@ def ground(slab: Construction) -> Effect:
 
 
 def sky(roof: Construction) -> Effect:
-    u = u_value(roof, R_SI_UP)
     return Effect(
         "sky_radiation",
         f"Uninsulated, high-emissivity pale roof: {roof.name} (thermal emissivity 0.9, "
-        f"solar absorptance {_outer_absorptance(roof):.2f}, U = {u:.2f} W/(m²·K)).",
+        f"{_sun_and_u(roof, R_SI_UP)}).",
         {"roof": roof},
         {"sky_at_air_temperature": True},
         "the same roof under a sky at the outdoor air temperature",

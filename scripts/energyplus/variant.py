@@ -17,17 +17,13 @@ import pandas as pd
 
 from . import zones
 from .archetypes import Archetype, Calendar, radiant_floor
+from .geometry import SIDES, Box, Point2, Point3, VerticalRect
 from .idf import (
-    SIDES,
-    Box,
-    Point2,
-    Point3,
     RunPeriod,
     SiteInfo,
-    VerticalRect,
+    building_ground_temperatures,
     building_surface,
     header,
-    idf_object,
     materials_and_constructions,
     output_variables,
     sky_at_air_temperature,
@@ -317,11 +313,7 @@ class Variant:
         if self.unmetered_w_m2 > 0.0:
             out.append(week_schedule("Equipment", OFFICE_EQUIPMENT))
         if self.ground_slab is not None:
-            # The EPW header's 4 m soil temperatures: under a building the ground is steadier
-            # (and in winter warmer) than the surface soil.
-            out.append(
-                idf_object("Site:GroundTemperature:BuildingSurface", *site.ground_temperatures[4.0])
-            )
+            out.append(building_ground_temperatures(site))
         if self.sky_at_air_temperature:
             out.append(sky_at_air_temperature())
         if self.replayed_heat is not None:

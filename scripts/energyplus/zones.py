@@ -37,37 +37,35 @@ def activity_schedule(name: str = "Activity") -> str:
 def lights(zone_name: str, watts_per_m2: float, schedule: str) -> str:
     """Lighting; radiant / visible fractions of suspended fluorescent luminaires
     (EnergyPlus Input Output Reference, Lights, table of heat gain fractions)."""
-    return idf_object(
-        "Lights",
-        f"{zone_name} Lights",
-        zone_name,
-        schedule,
-        "Watts/Area",
-        None,
-        watts_per_m2,
-        None,
-        0.0,
-        0.42,
-        0.18,
-        1.0,
-        "General",
+    # Fractions: return air 0, radiant 0.42, visible 0.18; replaceable 1.
+    return _gain_per_area(
+        "Lights", "Lights", zone_name, watts_per_m2, schedule, 0.0, 0.42, 0.18, 1.0
     )
 
 
 def electric_equipment(zone_name: str, watts_per_m2: float, schedule: str) -> str:
     """Plug loads (office equipment): half radiant."""
+    # Fractions: latent 0, radiant 0.5, lost 0.
+    return _gain_per_area(
+        "ElectricEquipment", "Equipment", zone_name, watts_per_m2, schedule, 0.0, 0.5, 0.0
+    )
+
+
+def _gain_per_area(
+    kind: str, tag: str, zone_name: str, watts_per_m2: float, schedule: str, *fractions: float
+) -> str:
+    """A ``kind`` gain of ``watts_per_m2`` of floor on ``schedule``, split by the object's own
+    heat ``fractions``. [W/m²]"""
     return idf_object(
-        "ElectricEquipment",
-        f"{zone_name} Equipment",
+        kind,
+        f"{zone_name} {tag}",
         zone_name,
         schedule,
         "Watts/Area",
         None,
         watts_per_m2,
         None,
-        0.0,
-        0.5,
-        0.0,
+        *fractions,
         "General",
     )
 
@@ -81,28 +79,24 @@ def infiltration(
 ) -> str:
     """Infiltration ``ach · (constant + per_wind · v_wind)``; v_wind is EnergyPlus's local
     wind speed at the zone centroid height. [1/h], [-], [s/m]"""
-    return idf_object(
-        "ZoneInfiltration:DesignFlowRate",
-        f"{zone_name} Infiltration",
-        zone_name,
-        schedule,
-        "AirChanges/Hour",
-        None,
-        None,
-        None,
-        ach,
-        constant,
-        0.0,
-        per_wind,
-        0.0,
-    )
+    # Coefficients: constant, temperature 0, velocity, velocity squared 0.
+    return _design_flow_rate("Infiltration", zone_name, ach, schedule, constant, 0.0, per_wind, 0.0)
 
 
 def ventilation(zone_name: str, ach: float, schedule: str) -> str:
     """Outdoor-air ventilation (balanced, no fan heat) at ``ach`` while ``schedule`` is on. [1/h]"""
+    # No fan pressure rise, fan efficiency 1; coefficients: constant 1, the others 0.
+    return _design_flow_rate(
+        "Ventilation", zone_name, ach, schedule, "Balanced", 0.0, 1.0, 1.0, 0.0, 0.0, 0.0
+    )
+
+
+def _design_flow_rate(kind: str, zone_name: str, ach: float, schedule: str, *rest: object) -> str:
+    """``Zone<kind>:DesignFlowRate``: ``ach`` air changes of outdoor air while ``schedule`` is
+    on; ``rest``: the object's own fields after the rate. [1/h]"""
     return idf_object(
-        "ZoneVentilation:DesignFlowRate",
-        f"{zone_name} Ventilation",
+        f"Zone{kind}:DesignFlowRate",
+        f"{zone_name} {kind}",
         zone_name,
         schedule,
         "AirChanges/Hour",
@@ -110,13 +104,7 @@ def ventilation(zone_name: str, ach: float, schedule: str) -> str:
         None,
         None,
         ach,
-        "Balanced",
-        0.0,
-        1.0,
-        1.0,
-        0.0,
-        0.0,
-        0.0,
+        *rest,
     )
 
 
@@ -136,25 +124,12 @@ def ideal_loads_heating(
     z = zone_name
     return "".join(
         [
-            idf_object(
-                "ZoneHVAC:EquipmentConnections",
+            _equipment(
                 z,
-                f"{z} Equipment",
-                f"{z} Supply Inlet",
-                None,
-                f"{z} Air Node",
-                f"{z} Return Outlet",
-            ),
-            idf_object(
-                "ZoneHVAC:EquipmentList",
-                f"{z} Equipment",
-                "SequentialLoad",
                 "ZoneHVAC:IdealLoadsAirSystem",
                 f"{z} Ideal Loads",
-                1,
-                1,
-                None,
-                None,
+                f"{z} Supply Inlet",
+                f"{z} Return Outlet",
             ),
             idf_object(
                 "ZoneHVAC:IdealLoadsAirSystem",
@@ -194,6 +169,32 @@ def ideal_loads_heating(
     )
 
 
+def _equipment(
+    zone_name: str, kind: str, name: str, inlet: str | None = None, outlet: str | None = None
+) -> str:
+    """The zone's equipment connections and its list of one piece of equipment, ``kind``
+    ``name``; ``inlet`` / ``outlet``: the air nodes of equipment that moves air."""
+    return idf_object(
+        "ZoneHVAC:EquipmentConnections",
+        zone_name,
+        f"{zone_name} Equipment",
+        inlet,
+        None,
+        f"{zone_name} Air Node",
+        outlet,
+    ) + idf_object(
+        "ZoneHVAC:EquipmentList",
+        f"{zone_name} Equipment",
+        "SequentialLoad",
+        kind,
+        name,
+        1,
+        1,
+        None,
+        None,
+    )
+
+
 def single_heating_control_schedule() -> str:
     """Control-type schedule of ``ZoneControl:Thermostat``: 1 = single heating setpoint."""
     return constant_schedule("SingleHeatingControl", 1)
@@ -224,26 +225,7 @@ def radiant_floor_heating(
                 0.15,
                 0.0,
             ),
-            idf_object(
-                "ZoneHVAC:EquipmentConnections",
-                zone_name,
-                f"{zone_name} Equipment",
-                None,
-                None,
-                f"{zone_name} Air Node",
-                None,
-            ),
-            idf_object(
-                "ZoneHVAC:EquipmentList",
-                f"{zone_name} Equipment",
-                "SequentialLoad",
-                "ZoneHVAC:LowTemperatureRadiant:Electric",
-                name,
-                1,
-                1,
-                None,
-                None,
-            ),
+            _equipment(zone_name, "ZoneHVAC:LowTemperatureRadiant:Electric", name),
             idf_object(
                 "ZoneHVAC:LowTemperatureRadiant:Electric",
                 name,
