@@ -3,6 +3,7 @@ out by hand and integrated with scipy's solve_ivp (not the engine's network or d
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -10,11 +11,19 @@ import pandas as pd
 from scipy.integrate import solve_ivp
 
 from rcengine.building import Building
+from rcengine.diagnose.candidates import Context
+from rcengine.diagnose.fitting import fit_model, split_data
+from rcengine.diagnose.settings import split_time
+from rcengine.models import get_model
+from rcengine.signals import SignalOptions
 
 STEP_S = 900.0
 
-BUILDING = Building.from_dict(
-    {
+
+
+def office(**changes: object) -> Building:
+    """The synthetic office in Turin (the thesis's sizes), with ``changes`` to its description."""
+    description = {
         "name": "synthetic-office",
         "location": {"latitude": 45.07, "longitude": 7.69, "timezone": "Europe/Rome"},
         "floor_area": 1050.0,
@@ -22,7 +31,10 @@ BUILDING = Building.from_dict(
         "wall_area": 455.0,
         "internal_mass_area": 560.0,
     }
-)
+    return Building.from_dict({**description, **changes})
+
+
+BUILDING = office()
 
 TRUTH_BASIC = {
     "r_wall_ext": 1.2,
@@ -115,3 +127,17 @@ def with_recorded_weather(frame: pd.DataFrame, csv_path: str | Path) -> pd.DataF
     if weather.isna().any().any():
         raise ValueError(f"{csv_path} does not cover {frame.index[0]} … {frame.index[-1]}")
     return frame.assign(**{c: weather[c].to_numpy() for c in WEATHER_COLUMNS})
+
+
+def fitted_context(frame: pd.DataFrame, model: str, fraction: float) -> Context:
+    """What a candidate sees after a baseline fit of ``model`` (BUILDING, "default" preset) on
+    the first ``fraction`` of ``frame``: the training data, parameters and residual."""
+    network = get_model(model, BUILDING, frame.columns)
+    boundary = split_time(frame, fraction, BUILDING.location.timezone)
+    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fit = fit_model(network, SignalOptions(), split, "default", 0)
+    return Context(
+        network, BUILDING, fit.split.train, SignalOptions(), fit.params, fit.residual_train
+    )

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,7 @@ import pytest
 
 from rcengine.diagnose import DiagnoseSettings, diagnose, split_time
 from rcengine.diagnose.candidates import CANDIDATES, Context, Skipped
-from rcengine.diagnose.fitting import fit_model, residual_at, split_data
+from rcengine.diagnose.fitting import residual_at, split_data
 from rcengine.diagnose.html import render
 from rcengine.diagnose.response import explain_residual, node_responses, on_off_explainer
 from rcengine.io.timeseries import read_timeseries
@@ -22,7 +21,13 @@ from rcengine.models import get_model
 from rcengine.signals import SignalOptions
 from rcengine.signals.schedules import CLOCKS, clock_zone
 from rcengine.simulate import simulate
-from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from tests.synthetic import (
+    BUILDING,
+    TRUTH_BASIC,
+    basic_reference,
+    fitted_context,
+    weather_and_gains,
+)
 
 # The hidden gain: a kitchen on weekday mornings, on a schedule no column carries. [W]
 HIDDEN_GAIN_W = 15_000.0
@@ -35,15 +40,7 @@ def _hidden_gain(times: pd.DatetimeIndex, zone: str | dt.tzinfo | None = None) -
 
 def _learnt_gain_schedule(frame: pd.DataFrame) -> dict:
     """The unmetered-gain candidate learnt from the residual of a baseline fit on 70 % of frame."""
-    network = get_model("basic", BUILDING, frame.columns)
-    boundary = split_time(frame, 0.7, BUILDING.location.timezone)
-    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        base = fit_model(network, SignalOptions(), split, "default", 0)
-    ctx = Context(
-        network, BUILDING, base.split.train, SignalOptions(), base.params, base.residual_train
-    )
+    ctx = fitted_context(frame, "basic", 0.7)
     return CANDIDATES["unmetered_gains"](ctx).detail
 
 

@@ -4,17 +4,16 @@ capacity not learnt as a schedule."""
 
 from __future__ import annotations
 
-import warnings
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from rcengine.building import Building
 from rcengine.columns import T_GROUND, UNIT
-from rcengine.diagnose import candidates, split_time
+from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
-from rcengine.diagnose.fitting import fit_model, split_data
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.response import node_responses
 from rcengine.models import get_model
@@ -22,27 +21,24 @@ from rcengine.signals import SignalOptions, prepare
 from rcengine.signals.derived import derive
 from rcengine.signals.ground import YEAR_S, annual_cycle, seasonal_ground_temperature
 from rcengine.signals.schedules import day_type_hour
-from tests.synthetic import BUILDING, TRUTH_BASIC, weather_and_gains
+from tests.synthetic import BUILDING, TRUTH_BASIC, fitted_context, office, weather_and_gains
 
-SMALL = Building.from_dict(
-    {
-        "name": "small-office",
-        "location": {"latitude": 45.07, "longitude": 7.69, "timezone": "Europe/Rome"},
-        "floor_area": 120.0,
-        "volume": 360.0,
-        "wall_area": 150.0,
-        "internal_mass_area": 120.0,
-        "windows": [
-            {"azimuth": 225, "tilt": 90, "area": 12.0},
-            {"azimuth": 270, "tilt": 90, "area": 6.0},
-            {"azimuth": 0, "tilt": 90, "area": 4.0},
-        ],
-        "walls": [
-            {"azimuth": 180, "tilt": 90, "area": 40.0},
-            {"azimuth": 270, "tilt": 90, "area": 30.0},
-            {"azimuth": 0, "tilt": 0, "area": 120.0},
-        ],
-    }
+SMALL = office(
+    name="small-office",
+    floor_area=120.0,
+    volume=360.0,
+    wall_area=150.0,
+    internal_mass_area=120.0,
+    windows=[
+        {"azimuth": 225, "tilt": 90, "area": 12.0},
+        {"azimuth": 270, "tilt": 90, "area": 6.0},
+        {"azimuth": 0, "tilt": 90, "area": 4.0},
+    ],
+    walls=[
+        {"azimuth": 180, "tilt": 90, "area": 40.0},
+        {"azimuth": 270, "tilt": 90, "area": 30.0},
+        {"azimuth": 0, "tilt": 0, "area": 120.0},
+    ],
 )
 
 
@@ -91,52 +87,60 @@ def _between(ext: Extension) -> float:
     return (ext.detail["outdoor_mean_c"] + ext.detail["indoor_mean_c"]) / 2
 
 
-# effect → (plausible fit, implausible fit, words of the reason) as functions of the extension.
+class Case(NamedTuple):
+    """A fit the candidate accepts, one it rejects and words of the rejection's reason; the fits
+    as functions of the extension."""
+
+    plausible: Callable[[Extension], dict[str, float]]
+    implausible: Callable[[Extension], dict[str, float]]
+    reason: str
+
+
 CASES = {
-    "window_solar_gains": (
+    "window_solar_gains": Case(
         lambda e: _window(e, 0.6),
         lambda e: {**_window(e, 0.6), "g_window_225_90": 1.3},
         "implied g-value of the south-west glazing: 1.4 exceeds any glazing (≤ 0.87)",
     ),
-    "opaque_solar_gains": (
+    "opaque_solar_gains": Case(
         lambda e: dict.fromkeys(e.new_parameters, 0.6),
         lambda e: {**dict.fromkeys(e.new_parameters, 0.6), "a_opaque_180_90": 1.6},
         "solar absorptance of the south opaque surfaces: 1.6 exceeds any opaque surface",
     ),
-    "wind_infiltration": (
+    "wind_infiltration": Case(
         lambda e: {"ach_wind": 0.15},
         lambda e: {"ach_wind": 0.9},
         "wind-driven air changes per m/s of wind, of 360 m³: 0.9 1/h per m/s exceeds any envelope",
     ),
-    "ventilation_schedule": (
+    "ventilation_schedule": Case(
         lambda e: {"ach_vent": 1.5},
         lambda e: {"ach_vent": 8.0},
         "air changes in the scheduled hours, of 360 m³: 8 1/h exceeds any ventilated building",
     ),
-    "unmetered_gains": (
+    "unmetered_gains": Case(
         lambda e: {"q_unmetered": 12.0},
         lambda e: {"q_unmetered": 70.0},
         "unmetered internal gain in the scheduled hours, per m² of floor (8400 W): 70 W/m² "
         "exceeds any occupied floor (≤ 40 W/m²)",
     ),
-    "ground_coupling": (
+    "ground_coupling": Case(
         lambda e: _ground(e, 0.5, _between(e)),
         lambda e: _ground(e, 3.0, _between(e)),
         "U-value of the ground floor: 3 W/(m²K) exceeds any floor (≤ 2 W/(m²K))",
     ),
-    "sky_radiation": (
+    "sky_radiation": Case(
         lambda e: {"h_sky": 4.0},
         lambda e: {"h_sky": 11.0},
         "long-wave coupling ε·h_r to the sky, per m² of roof + ½ wall (155 m²): 11 W/(m²K) "
         "exceeds any envelope surface",
     ),
-    "thermal_mass": (
+    "thermal_mass": Case(
         lambda e: {"c_mass_extra": 2e5, "r_mass_extra": 0.1},
         lambda e: {"c_mass_extra": 1.8e6, "r_mass_extra": 0.1},
         "added heat capacity per m² of floor: 1.8e+03 kJ/(m²K) exceeds any building's internal "
         "mass (≤ 1e+03 kJ/(m²K))",
     ),
-    "emitter_dynamics": (
+    "emitter_dynamics": Case(
         lambda e: {"c_emitter": 2e4, "r_emitter": 0.2},
         lambda e: {"c_emitter": 1e5, "r_emitter": 1.0},
         "emitter time constant: 27.8 h exceeds any emitter (fan coil to screeded floor) (≤ 24 h)",
@@ -151,14 +155,14 @@ def test_every_candidate_has_a_plausibility_case():
 @pytest.mark.parametrize("effect", sorted(CASES))
 def test_an_impossible_fit_is_rejected_with_its_reason(effect, gain_context, loss_context):
     ext = _built(effect, gain_context, loss_context)
-    plausible, implausible, reason = CASES[effect]
-    fitted = plausible(ext)
+    case = CASES[effect]
+    fitted = case.plausible(ext)
     assert set(fitted) == set(ext.new_parameters)
     accepted = assess(ext, {**TRUTH_BASIC, **fitted})
     assert accepted.plausible, accepted.problems
-    rejected = assess(ext, {**TRUTH_BASIC, **implausible(ext)})
+    rejected = assess(ext, {**TRUTH_BASIC, **case.implausible(ext)})
     assert not rejected.plausible
-    assert any(reason in p for p in rejected.problems), rejected.problems
+    assert any(case.reason in p for p in rejected.problems), rejected.problems
     for magnitude in rejected.magnitudes.values():
         assert set(magnitude) == {"value", "unit", "meaning"} and np.isfinite(magnitude["value"])
 
@@ -250,15 +254,8 @@ def _saturating_record() -> pd.DataFrame:
 def test_a_heater_at_capacity_is_not_learnt_as_a_gain_schedule(monkeypatch):
     """A one-capacity model cannot follow the mornings' recovery at capacity; without the mask
     its residual is learnt as a weekday-morning "unmetered gain" over those hours."""
-    record = _saturating_record()
-    network = get_model("1r1c", BUILDING, record.columns)
-    boundary = split_time(record, 0.8, BUILDING.location.timezone)
-    split = split_data(record, BUILDING, network, SignalOptions(), boundary)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fit = fit_model(network, SignalOptions(), split, "default", 0)
-    train = fit.split.train
-    ctx = Context(network, BUILDING, train, SignalOptions(), fit.params, fit.residual_train)
+    ctx = fitted_context(_saturating_record(), "1r1c", 0.8)
+    train = ctx.data
     saturated = heater_saturated(train.frame)
     assert 0 < saturated.sum() < 0.5 * (train.frame["q_hvac"] > 450.0).sum()
     hour = day_type_hour(train.times, BUILDING.location.timezone)

@@ -348,9 +348,17 @@ def _with_gain(
     )
 
 
-def _per_air_change(ctx: Context) -> float:
-    """Conductance of one air change per hour through the zone, ρ·c_p·V/3600. [W/K per 1/h]"""
-    return RHO_CP_AIR * ctx.building.volume / 3600.0
+def _air_change_loss(
+    ctx: Context, effect: str, rate: str, unit: str, highest: float, meaning: str, loss: str
+) -> Extension:
+    """The current network plus an air-change rate ``rate`` [``unit``], searched from none up to
+    SEARCH_MARGIN × the ``highest`` plausible rate, times the ``loss`` signal into the output
+    node, each air change per hour through the zone a conductance of ρ·c_p·V/3600 [W/K]."""
+    parameter = Parameter(rate, unit, 0.0, SEARCH_MARGIN * highest, meaning)
+    heat = (loss, ctx.network.output)
+    detail = {"volume_m3": ctx.building.volume}
+    per_air_change = RHO_CP_AIR * ctx.building.volume / 3600.0  # [W/K per 1/h]
+    return _with_gain(ctx, effect, parameter, heat, detail, per_air_change)
 
 
 def wind_infiltration(ctx: Context) -> Extension | Skipped:
@@ -359,16 +367,15 @@ def wind_infiltration(ctx: Context) -> Extension | Skipped:
     effect = "wind_infiltration"
     if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
         return Skipped(effect, "no wind_speed column in the data")
-    ach_wind = Parameter(
+    return _air_change_loss(
+        ctx,
+        effect,
         "ach_wind",
         "1/h per m/s",
-        0.0,
-        SEARCH_MARGIN * WIND_ACH_PER_M_S[1],
+        WIND_ACH_PER_M_S[1],
         f"air changes per hour per m/s of wind: loss = n·ρc_pV/3600·wind·({T_REF_C:g} °C − t_out)",
+        WIND_LOSS,
     )
-    heat = (WIND_LOSS, ctx.network.output)
-    detail = {"volume_m3": ctx.building.volume}
-    return _with_gain(ctx, effect, ach_wind, heat, detail, _per_air_change(ctx))
 
 
 @dataclass(frozen=True)
@@ -523,17 +530,11 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess, saturated)
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
-    ach_vent = Parameter(
-        "ach_vent",
-        "1/h",
-        0.0,
-        SEARCH_MARGIN * VENTILATION_ACH[1],
+    meaning = (
         f"air changes per hour in the scheduled hours (loss = n·ρc_pV/3600·({T_REF_C:g} °C − "
-        "t_out))",
+        "t_out))"
     )
-    heat = (VENT_LOSS, ctx.network.output)
-    detail = {"volume_m3": ctx.building.volume}
-    ext = _with_gain(ctx, effect, ach_vent, heat, detail, _per_air_change(ctx))
+    ext = _air_change_loss(ctx, effect, "ach_vent", "1/h", VENTILATION_ACH[1], meaning, VENT_LOSS)
     return _on_schedule(ext, VENT_SCHEDULE, learnt)
 
 
