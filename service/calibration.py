@@ -7,19 +7,24 @@ Timeline, ending at the last measured ``t_in`` (``end`` = its time + one step)::
 
 The new set is fitted on the training rows. Both the new and the current set then forecast the
 held-out day the way the service forecasts (Kalman-filtered state from the rows before it, open
-loop over the day's inputs); the new set becomes current only if its RMSE there is no worse.
-A failed fit or a worse set never replaces the current one; both are stored with their reason.
+loop over the day's inputs); the new set becomes current only if its RMSE there is no worse
+and it passes the promotion gate (``service.promotion``: no flat t_in, heating that varies,
+parameters mostly inside their bounds, better than persistence, plausible predictions). A
+failed fit, a worse or a refused set never replaces the current one; each is stored with its
+reason (the job's ``details.gate`` names the checks that refused it).
 
 :func:`work` is what a calibration job runs (the job itself is handled by ``service.jobs``).
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass, replace
 from datetime import datetime
 from typing import Any
 
+import numpy as np
 import pandas as pd
 from sqlalchemy.orm import Session
 
@@ -33,7 +38,7 @@ from rcengine.models import get_model
 from rcengine.parameter_set import ParameterSet
 from rcengine.signals import prepare
 
-from . import bridge, repository
+from . import bridge, promotion, repository
 from .core.db import Database
 from .errors import CalibrationError
 from .models import PROMOTED, REJECTED, JobRecord
@@ -82,6 +87,7 @@ class Calibrated:
     promote: bool
     reason: str
     warnings: list[str]
+    gate: promotion.Verdict
 
     @property
     def outcome(self) -> str:
@@ -111,6 +117,7 @@ class Calibrated:
             "n_simulations": fit["n_simulations"],
             "fit_wall_time_s": fit["wall_time_s"],
             "warnings": self.warnings,
+            "gate": self.gate.to_dict(),
         }
 
 
@@ -133,19 +140,22 @@ def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrate
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConvergenceWarning)
         fitted = fit_parameter_set(training, building, job.model, options)
-    new_score = holdout_score(fitted, frame, window)
+    holdout, predicted = holdout_forecast(fitted, frame, window)
+    new_score = evaluate(holdout[T_IN].to_numpy(dtype=float), predicted)
     fitted = replace(fitted, metrics={**fitted.metrics, "holdout": new_score.to_dict()})
     current_score, note = _score_current(current_set, frame, window)
-    promote = current_score is None or new_score.rmse <= current_score.rmse
+    gate = promotion.judge(fitted, training, holdout, predicted)
+    better = current_score is None or new_score.rmse <= current_score.rmse
     return Calibrated(
         fitted,
         window,
         new_score,
         current_score,
         None if current is None else current.id,
-        promote,
-        note or _verdict(new_score, current_score),
+        better and gate.passed,
+        gate.reason() if not gate.passed else note or _verdict(new_score, current_score),
         [str(w.message) for w in caught],
+        gate,
     )
 
 
@@ -160,13 +170,32 @@ def fit_parameter_set(
     return ParameterSet.from_estimator(estimator, data, building, model)
 
 
-def holdout_score(pset: ParameterSet, frame: pd.DataFrame, window: Window) -> FitMetrics:
-    """Metrics of a day-ahead forecast of the held-out day against its measured ``t_in``."""
+def holdout_forecast(
+    pset: ParameterSet, frame: pd.DataFrame, window: Window
+) -> tuple[pd.DataFrame, np.ndarray]:
+    """The held-out rows and the set's day-ahead forecast of their ``t_in``. [°C]"""
     hours = (window.end - window.holdout_start).total_seconds() / 3600.0
     data = pset.prepare(frame)
     predicted = forecast(pset.compiled, pset.values, data, window.holdout_start, hours)
-    measured = frame[T_IN].reindex(predicted.times).to_numpy(dtype=float)
-    return evaluate(measured, predicted.t_in_pred)
+    return frame.reindex(predicted.times), predicted.t_in_pred
+
+
+def holdout_score(pset: ParameterSet, frame: pd.DataFrame, window: Window) -> FitMetrics:
+    """Metrics of a day-ahead forecast of the held-out day against its measured ``t_in``."""
+    holdout, predicted = holdout_forecast(pset, frame, window)
+    return evaluate(holdout[T_IN].to_numpy(dtype=float), predicted)
+
+
+def days_used(
+    requested: int, first_stored: datetime, last_measured: datetime, step_s: float,
+    holdout_h: float = HOLDOUT_H,
+) -> int:
+    """The days a calibration asked for ``requested`` days fits: at most the whole or partial
+    days stored before the held-out day (at least 1: too little data fails the job, saying so).
+    """
+    window = _window(last_measured, step_s, requested, holdout_h)
+    stored = (window.holdout_start - pd.Timestamp(first_stored)) / pd.Timedelta(days=1)
+    return max(1, min(requested, math.ceil(stored)))
 
 
 def _window(

@@ -110,18 +110,22 @@ def plan(
     DataValidationError : naming ``start`` or ``end`` when the window holds no measured row.
     """
     measured_end = pd.Timestamp(last_measured) + pd.Timedelta(seconds=step_s)
-    end = measured_end if spec.end is None else min(spec.end, measured_end)
+    asked_end = measured_end if spec.end is None else spec.end
     days = pd.Timedelta(days=spec.days or default_days)
-    start = max(end - days if spec.start is None else spec.start, pd.Timestamp(first_stored))
+    asked_start = asked_end - days if spec.start is None else spec.start
+    end = min(asked_end, measured_end)
+    start = max(asked_start, pd.Timestamp(first_stored))
     if end <= start:
+        # The window asked for, as asked: the clipped one can come out inverted.
         raise DataValidationError(
             [
                 Problem(
                     None,
                     "start" if spec.start is not None else "end",
-                    f"the window {start.isoformat()} to {end.isoformat()} holds no measured "
-                    f"data: rows are stored from {pd.Timestamp(first_stored).isoformat()}, "
-                    f"t_in until {pd.Timestamp(last_measured).isoformat()}",
+                    f"the window {asked_start.isoformat()} to {asked_end.isoformat()} holds no "
+                    f"measured data: rows are stored from "
+                    f"{pd.Timestamp(first_stored).isoformat()}, t_in until "
+                    f"{pd.Timestamp(last_measured).isoformat()}",
                 )
             ]
         )

@@ -29,6 +29,10 @@ class NoParameterSetError(ConflictError):
         )
 
 
+class LeaseLostError(ServiceError):
+    """A job run's lease was taken over (its job failed as abandoned): its writes are refused."""
+
+
 class CalibrationError(ServiceError):
     """A calibration cannot run on the stored data (too little data, gaps, ...)."""
 

@@ -7,18 +7,28 @@ the transaction that marks it succeeded — or, when the work raises, marks it f
 reason, the building's current set and latest report untouched. A kind supplies only its work
 function (``calibration.work``, ``diagnosis.work``): ``work(db, job, options)`` returns a
 :class:`Product`.
+
+A run holds its job by a lease (owner, fencing token, heartbeat, expiry; see
+``repository.start_job``): a heartbeat thread renews it, and the run's final write must still
+hold it, or nothing of the run is stored. Jobs whose lease expired (their process died with its
+server) are failed at start-up and by a reaper thread, which moves the token on.
 """
 
 from __future__ import annotations
 
 import logging
+import os
+import queue
+import socket
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor, Future
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from sqlalchemy.exc import SQLAlchemyError
 from sqlalchemy.orm import Session
 
 from rcengine.exceptions import RCEngineError
@@ -28,9 +38,8 @@ from .calibration import CalibrationOptions
 from .core.config import Settings
 from .core.db import Database
 from .diagnosis import DiagnosisOptions, DiagnosisSpec
-from .errors import ConflictError, ServiceError
+from .errors import ConflictError, LeaseLostError, ServiceError
 from .models import (
-    ACTIVE_JOB_STATUSES,
     CALIBRATION,
     DIAGNOSIS,
     FAILED,
@@ -71,47 +80,92 @@ def kinds(settings: Settings) -> dict[str, tuple[Work, Any]]:
     }
 
 
-def run_job(database_url: str, job_id: int, work: Work, options: Any) -> None:
+def run_job(database_url: str, job_id: int, work: Work, options: Any, terms: LeaseTerms) -> None:
     """Worker entry: its own database engine, then :func:`execute`."""
     db = Database(database_url)
     try:
-        execute(db, job_id, work, options)
+        execute(db, job_id, work, options, terms)
     finally:
         db.dispose()
 
 
-def execute(db: Database, job_id: int, work: Work, options: Any) -> str:
-    """Run a queued job to its end; returns its final status. Never raises for failed work."""
+@dataclass(frozen=True)
+class LeaseTerms:
+    """Who runs a job (a server process) and for how long a lease lasts unrenewed. [s]"""
+
+    owner: str = field(default_factory=lambda: f"{socket.gethostname()}:{os.getpid()}")
+    seconds: float = 30.0
+
+
+def execute(
+    db: Database, job_id: int, work: Work, options: Any, terms: LeaseTerms | None = None
+) -> str:
+    """Run a queued job to its end under a lease; returns its final status. Never raises for
+    failed work; LeaseLostError when the lease was taken over (nothing of this run is stored).
+    """
+    terms = terms or LeaseTerms()
     started = time.perf_counter()
     with db.write() as session:
-        job = repository.start_job(session, job_id)
-    context = {"job_id": job_id, "building_id": job.building_id}
+        lease = repository.start_job(session, job_id, terms.owner, terms.seconds)
+        job = repository.get_job(session, job_id)
+    context = {"job_id": job_id, "building_id": job.building_id, "lease": str(lease)}
     log.info("%s started", job.kind, extra=context)
-    try:
-        product = work(db, job, options)
-    except Exception as exc:  # every failure is stored with its reason
-        error = describe(exc)
+    with _Heartbeat(db, lease, terms.seconds):
+        try:
+            product = work(db, job, options)
+        except Exception as exc:  # every failure is stored with its reason
+            error = describe(exc)
+            with db.write() as session:
+                repository.finish_job(session, job_id, FAILED, error=error, lease=lease)
+            log.warning(
+                "%s failed",
+                job.kind,
+                extra={**context, "error": error},
+                exc_info=not isinstance(exc, RCEngineError | ServiceError),
+            )
+            return FAILED
         with db.write() as session:
-            repository.finish_job(session, job_id, FAILED, error=error)
-        log.warning(
-            "%s failed",
-            job.kind,
-            extra={**context, "error": error},
-            exc_info=not isinstance(exc, RCEngineError | ServiceError),
-        )
-        return FAILED
-    with db.write() as session:
-        details = product.save(session, job)
-        details["duration_s"] = round(time.perf_counter() - started, 3)
-        repository.finish_job(
-            session, job_id, SUCCEEDED, outcome=product.outcome, details=details
-        )
+            details = product.save(session, job)
+            details["duration_s"] = round(time.perf_counter() - started, 3)
+            # Fenced: a run whose lease was taken over raises here, and what it saved rolls back.
+            repository.finish_job(
+                session, job_id, SUCCEEDED, outcome=product.outcome, details=details, lease=lease
+            )
     log.info(
         "%s finished",
         job.kind,
         extra={**context, "outcome": product.outcome, "details": details},
     )
     return SUCCEEDED
+
+
+class _Heartbeat:
+    """Renews a lease every third of its length on a thread while the work runs."""
+
+    def __init__(self, db: Database, lease: repository.Lease, seconds: float):
+        self.db, self.lease, self.seconds = db, lease, seconds
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._beat, name="lease", daemon=True)
+
+    def __enter__(self) -> _Heartbeat:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+
+    def _beat(self) -> None:
+        while not self._stop.wait(self.seconds / 3.0):
+            try:
+                with self.db.write() as session:
+                    held = repository.renew_lease(session, self.lease, self.seconds)
+            except SQLAlchemyError as exc:  # the database is away: the next beat tries again
+                log.warning("lease not renewed", extra={"job_id": self.lease.job_id, "error": exc})
+                continue
+            if not held:
+                log.warning("lease lost", extra={"job_id": self.lease.job_id})
+                return
 
 
 def describe(exc: BaseException) -> str:
@@ -126,9 +180,14 @@ class JobRunner:
     def __init__(self, settings: Settings, db: Database):
         self.settings = settings
         self.db = db
+        self.terms = LeaseTerms(seconds=settings.job_lease_s)
         self._kinds = kinds(settings)
         self._lock = threading.Lock()
-        self._executor = self._new_executor()
+        self._dispatcher = Dispatcher()
+        self._executor = self._dispatcher.submit(self._new_executor).result()
+        self._stop = threading.Event()
+        self._reaper = threading.Thread(target=self._reap, name="lease-reaper", daemon=True)
+        self._reaper.start()
 
     def create_calibration(
         self, building_id: int, model: str, days: int, trigger: str
@@ -136,8 +195,7 @@ class JobRunner:
         """Queue a calibration on ``days`` before the held-out day and submit it; ConflictError
         if the building has one active or has no measured data yet."""
         with self.db.write() as session:
-            _measured_building(session, building_id)
-            job = repository.add_job(session, building_id, trigger, model, days, CALIBRATION)
+            job = add_calibration(session, building_id, trigger, model, days)
         self.submit(job.id, CALIBRATION)
         return job
 
@@ -155,25 +213,47 @@ class JobRunner:
                 building.step_s,
                 self.settings.diagnosis_days,
             )
+            asked = {} if spec.days in (None, window.days) else {"days_requested": spec.days}
             job = repository.add_job(
-                session, building_id, trigger, model, window.days, DIAGNOSIS, window.to_dict()
+                session,
+                building_id,
+                trigger,
+                model,
+                window.days,
+                DIAGNOSIS,
+                {**window.to_dict(), **asked},
             )
         self.submit(job.id, DIAGNOSIS)
         return job
 
     def submit(self, job_id: int, kind: str) -> None:
+        handed = self._dispatcher.submit(self._hand_over, job_id, kind)
+        handed.add_done_callback(lambda f: self._finished(job_id, f))
+
+    def _hand_over(self, job_id: int, kind: str) -> None:
         work, options = self._kinds[kind]
+        arguments = (run_job, self.db.url, job_id, work, options, self.terms)
         try:
-            future = self._executor.submit(run_job, self.db.url, job_id, work, options)
+            future = self._executor.submit(*arguments)
         except BrokenProcessPool:  # a worker died (killed, out of memory): start a new pool
             with self._lock:
                 self._executor = self._new_executor()
-            future = self._executor.submit(run_job, self.db.url, job_id, work, options)
+            future = self._executor.submit(*arguments)
         future.add_done_callback(lambda f: self._finished(job_id, f))
 
     def shutdown(self) -> None:
         """Cancel jobs not yet started (marked failed); let running ones finish."""
+        self._stop.set()
+        self._dispatcher.cancel_pending()
         self._executor.shutdown(wait=False, cancel_futures=True)
+
+    def _reap(self) -> None:
+        """Fail running jobs whose lease expired (their process died) while the server runs."""
+        while not self._stop.wait(max(self.terms.seconds / 2.0, 0.5)):
+            try:
+                fail_abandoned(self.db)
+            except SQLAlchemyError as exc:  # the database is away: try again at the next round
+                log.warning("abandoned jobs not reaped", extra={"error": str(exc)})
 
     def _finished(self, job_id: int, future: Future) -> None:
         # The worker records every failure itself; this catches a worker that died or could
@@ -181,11 +261,15 @@ class JobRunner:
         exc = None if future.cancelled() else future.exception()
         if not future.cancelled() and exc is None:
             return
+        if isinstance(exc, LeaseLostError):  # the job was failed when its lease expired
+            log.warning("job run fenced off", extra={"job_id": job_id, "error": str(exc)})
+            return
         reason = INTERRUPTED if future.cancelled() else f"worker error: {describe(exc)}"
-        with self.db.write() as session:
-            job = repository.get_job(session, job_id)
-            if job.status in ACTIVE_JOB_STATUSES:
+        try:
+            with self.db.write() as session:
                 repository.finish_job(session, job_id, FAILED, error=reason)
+        except LeaseLostError:  # it had ended already
+            return
         log.error("job ended abnormally", extra={"job_id": job_id, "error": reason})
 
     def _new_executor(self) -> Executor:
@@ -193,6 +277,57 @@ class JobRunner:
         if self.settings.workers > 0:
             executor.submit(warm_up)
         return executor
+
+
+class Dispatcher:
+    """One daemon thread that runs what is handed to it, in order, for the life of the process.
+
+    Worker processes are started by the thread that submits to the pool, and a worker's
+    parent-death signal fires when *that thread* ends: every hand-over to the pool goes through
+    this thread, which never ends before the process does, so the signal fires only when the
+    server dies (and not on a graceful stop, which lets running jobs finish).
+    """
+
+    def __init__(self) -> None:
+        self._tasks: queue.SimpleQueue[tuple[Future, Callable[..., Any], tuple]] = (
+            queue.SimpleQueue()
+        )
+        threading.Thread(target=self._run, name="dispatch", daemon=True).start()
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+        future: Future = Future()
+        self._tasks.put((future, fn, args))
+        return future
+
+    def cancel_pending(self) -> None:
+        """Cancel what was not handed over yet (their callbacks run: the jobs are failed)."""
+        while not self._tasks.empty():
+            future, _, _ = self._tasks.get_nowait()
+            future.cancel()
+            future.set_running_or_notify_cancel()
+
+    def _run(self) -> None:
+        while True:
+            future, fn, args = self._tasks.get()
+            if not future.set_running_or_notify_cancel():
+                continue
+            try:
+                future.set_result(fn(*args))
+            except BaseException as exc:  # handed to the future's callbacks
+                future.set_exception(exc)
+
+
+def add_calibration(
+    session: Session, building_id: int, trigger: str, model: str, days: int
+) -> JobRecord:
+    """A queued calibration of ``days``, or of the fewer days stored (the job's ``days`` says
+    what is fitted, its ``options`` what was asked); ConflictError as for any job, or when the
+    building has no measured data yet."""
+    building = _measured_building(session, building_id)
+    first = repository.building_summary(session, building_id).first_time
+    used = calibration.days_used(days, first, building.last_measured_at, building.step_s)
+    asked = None if used == days else {"days_requested": days}
+    return repository.add_job(session, building_id, trigger, model, used, CALIBRATION, asked)
 
 
 def _measured_building(session: Session, building_id: int) -> BuildingRecord:
@@ -205,9 +340,15 @@ def _measured_building(session: Session, building_id: int) -> BuildingRecord:
 
 
 def fail_interrupted(db: Database) -> list[int]:
-    """At start-up: jobs left queued or running by a previous server process failed."""
+    """At start-up: jobs left queued by a previous server process, and running ones whose lease
+    expired, failed (running ones still leased are failed by the reaper once it expires)."""
+    return fail_abandoned(db, queued_too=True)
+
+
+def fail_abandoned(db: Database, queued_too: bool = False) -> list[int]:
+    """Fail the jobs no live process holds (see :func:`repository.fail_abandoned_jobs`)."""
     with db.write() as session:
-        ids = repository.fail_active_jobs(session, INTERRUPTED)
+        ids = repository.fail_abandoned_jobs(session, INTERRUPTED, queued_too)
     if ids:
         log.warning("marked interrupted jobs failed", extra={"job_ids": ids})
     return ids
@@ -223,7 +364,7 @@ def queue_retraining(db: Database, settings: Settings, trigger: str) -> list[int
     for building_id in building_ids:
         try:
             with db.write() as session:
-                job = repository.add_job(
+                job = add_calibration(
                     session, building_id, trigger, settings.model, settings.training_days
                 )
             queued.append(job.id)
@@ -236,6 +377,6 @@ def retrain_all_inline(db: Database, settings: Settings, trigger: str) -> dict[i
     """``rcservice retrain-all``: queue and run every due calibration here, one after another."""
     work, options = kinds(settings)[CALIBRATION]
     return {
-        job_id: execute(db, job_id, work, options)
+        job_id: execute(db, job_id, work, options, LeaseTerms(seconds=settings.job_lease_s))
         for job_id in queue_retraining(db, settings, trigger)
     }

@@ -132,6 +132,12 @@ class JobRecord(Base):
     error: Mapped[str | None] = mapped_column(Text)
     details: Mapped[dict[str, Any] | None] = mapped_column(JSON)
     options: Mapped[dict[str, Any] | None] = mapped_column(JSON)
+    # The lease of the run that holds the job (see service.jobs): who runs it, the fencing
+    # token every write of that run must still match, its last heartbeat and expiry.
+    lease_owner: Mapped[str | None] = mapped_column(String(64))
+    lease_token: Mapped[int] = mapped_column(Integer, default=0, server_default="0")
+    heartbeat_at: Mapped[datetime | None]
+    lease_expires_at: Mapped[datetime | None]
 
     @property
     def parameter_set_id(self) -> int | None:

@@ -8,7 +8,8 @@ the Core-only query of the forecast hot path also runs on ``Database.connect()``
 from __future__ import annotations
 
 from collections.abc import Sequence
-from datetime import datetime
+from dataclasses import dataclass
+from datetime import datetime, timedelta
 from typing import Any
 
 from sqlalchemy import Connection, Insert, Row, Select, and_, func, select, update
@@ -18,7 +19,7 @@ from sqlalchemy.orm import Session
 
 from rcengine.columns import TIME
 
-from .errors import ConflictError, NotFoundError
+from .errors import ConflictError, LeaseLostError, NotFoundError
 from .models import (
     ACTIVE_JOB_STATUSES,
     CALIBRATION,
@@ -38,6 +39,18 @@ from .models import (
 )
 
 _INSERT = {"sqlite": sqlite.insert, "postgresql": postgresql.insert}
+
+
+@dataclass(frozen=True)
+class Lease:
+    """A run's hold on a job: the job, who runs it, and the fencing token of the run."""
+
+    job_id: int
+    owner: str
+    token: int
+
+    def __str__(self) -> str:
+        return f"{self.token} of {self.owner!r}"
 
 
 # --- buildings --------------------------------------------------------------------------------
@@ -61,6 +74,29 @@ def get_building(session: Session, building_id: int) -> BuildingRecord:
     if record is None:
         raise NotFoundError(f"building {building_id} not found")
     return record
+
+
+def lock_building(session: Session, building_id: int) -> BuildingRecord:
+    """The building, its row locked until the transaction ends (``SELECT … FOR UPDATE`` on
+    PostgreSQL; SQLite's write transactions hold the database's write lock already): writers of
+    one building's data run one after another."""
+    record = session.scalar(
+        select(BuildingRecord).where(BuildingRecord.id == building_id).with_for_update()
+    )
+    if record is None:
+        raise NotFoundError(f"building {building_id} not found")
+    return record
+
+
+def next_data_revision(session: Session, building_id: int) -> int:
+    """Increment the building's ``data_revision`` in the database (one atomic statement, no
+    read-then-write) and return the new value."""
+    return session.scalar(
+        update(BuildingRecord)
+        .where(BuildingRecord.id == building_id)
+        .values(data_revision=BuildingRecord.data_revision + 1)
+        .returning(BuildingRecord.data_revision)
+    )
 
 
 def building_summary(session: Session, building_id: int) -> Row:
@@ -228,12 +264,38 @@ def list_jobs(
     return session.scalars(query).all()
 
 
-def start_job(session: Session, job_id: int) -> JobRecord:
-    job = get_job(session, job_id)
-    if job.status != QUEUED:
-        raise ConflictError(f"job {job_id} is {job.status}, not queued")
-    job.status, job.started_at = RUNNING, utc_now()
-    return job
+def start_job(session: Session, job_id: int, owner: str = "", lease_s: float = 0.0) -> Lease:
+    """Mark a queued job running under a new lease of ``owner`` for ``lease_s``; ConflictError
+    if it is not queued. The job's fencing token is incremented: every later write of this run
+    must present it (:func:`renew_lease`, :func:`finish_job`)."""
+    now = utc_now()
+    token = session.scalar(
+        update(JobRecord)
+        .where(JobRecord.id == job_id, JobRecord.status == QUEUED)
+        .values(
+            status=RUNNING,
+            started_at=now,
+            lease_owner=owner,
+            lease_token=JobRecord.lease_token + 1,
+            heartbeat_at=now,
+            lease_expires_at=now + timedelta(seconds=lease_s),
+        )
+        .returning(JobRecord.lease_token)
+    )
+    if token is None:
+        raise ConflictError(f"job {job_id} is {get_job(session, job_id).status}, not queued")
+    return Lease(job_id, owner, token)
+
+
+def renew_lease(session: Session, lease: Lease, lease_s: float) -> bool:
+    """Heartbeat: extend the lease by ``lease_s`` from now; False if it was taken over."""
+    now = utc_now()
+    renewed = session.execute(
+        _held(update(JobRecord), lease).values(
+            heartbeat_at=now, lease_expires_at=now + timedelta(seconds=lease_s)
+        )
+    )
+    return renewed.rowcount == 1
 
 
 def finish_job(
@@ -244,21 +306,62 @@ def finish_job(
     outcome: str | None = None,
     error: str | None = None,
     details: dict[str, Any] | None = None,
-) -> JobRecord:
-    job = get_job(session, job_id)
-    job.status, job.outcome, job.error = status, outcome, error
-    job.details = details
-    job.finished_at = utc_now()
-    return job
+    lease: Lease | None = None,
+) -> None:
+    """End a job; with ``lease``, only if that lease still holds it (LeaseLostError, and the
+    caller's transaction must roll back, if not); without, only if it is still active. The
+    fencing token is incremented, so that no earlier lease can write again."""
+    query = update(JobRecord).where(JobRecord.id == job_id)
+    query = _held(query, lease) if lease else query.where(JobRecord.status.in_(ACTIVE_JOB_STATUSES))
+    ended = session.execute(
+        query.values(
+            status=status,
+            outcome=outcome,
+            error=error,
+            details=details,
+            finished_at=utc_now(),
+            lease_token=JobRecord.lease_token + 1,
+            lease_expires_at=None,
+        )
+    )
+    if ended.rowcount != 1:
+        job = get_job(session, job_id)
+        raise LeaseLostError(
+            f"job {job_id} is {job.status} under lease {job.lease_token} of "
+            f"{job.lease_owner!r}; this run's lease ({lease}) no longer holds it"
+        )
 
 
-def fail_active_jobs(session: Session, reason: str) -> list[int]:
-    """Mark every queued or running job failed (at start-up: their process is gone)."""
-    query = select(JobRecord).where(JobRecord.status.in_(ACTIVE_JOB_STATUSES))
-    jobs = session.scalars(query).all()
-    for job in jobs:
-        job.status, job.error, job.finished_at = FAILED, reason, utc_now()
-    return [job.id for job in jobs]
+def _held(query: Any, lease: Lease) -> Any:
+    return query.where(
+        JobRecord.id == lease.job_id,
+        JobRecord.status == RUNNING,
+        JobRecord.lease_token == lease.token,
+    )
+
+
+def fail_abandoned_jobs(session: Session, reason: str, queued_too: bool = False) -> list[int]:
+    """Fail running jobs whose lease expired (their process is gone), and queued ones too when
+    ``queued_too`` (at start-up: the process that queued them is gone); ids of the jobs failed.
+    Their fencing token moves on, so a late write of the dead run is refused."""
+    abandoned = (JobRecord.status == RUNNING) & (JobRecord.lease_expires_at < utc_now())
+    if queued_too:
+        abandoned = abandoned | (JobRecord.status == QUEUED)
+    ids = list(
+        session.scalars(
+            update(JobRecord)
+            .where(abandoned)
+            .values(
+                status=FAILED,
+                error=reason,
+                finished_at=utc_now(),
+                lease_token=JobRecord.lease_token + 1,
+                lease_expires_at=None,
+            )
+            .returning(JobRecord.id)
+        )
+    )
+    return sorted(ids)
 
 
 def buildings_with_new_data(session: Session) -> list[int]:

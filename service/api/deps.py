@@ -12,12 +12,13 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import Depends, HTTPException, Path, Request, Security, status
+from fastapi import Depends, HTTPException, Request, Security, status
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from .. import repository
 from ..context import ServiceContext
 from ..core.security import hash_token, same_hash
+from ..schemas.common import id_in_path
 
 bearer = HTTPBearer(
     auto_error=False,
@@ -59,7 +60,7 @@ async def require_admin(ctx: ContextDep, credentials: Credentials) -> None:
 
 
 async def building_access(
-    building_id: Annotated[int, Path(description="Building id", examples=[1])],
+    building_id: Annotated[int, id_in_path("Building", 1)],
     ctx: ContextDep,
     credentials: Credentials,
 ) -> int:

@@ -67,6 +67,13 @@ class Settings(BaseSettings):
         "thread of the server process (tests, tiny deployments).",
     )
     forecast_cache_size: int = Field(512, ge=0, description="Forecasts kept in memory.")
+    job_lease_s: float = Field(
+        30.0,
+        ge=1.0,
+        le=3600.0,
+        description="A running job's lease [s]: renewed every third of it by the job's process; "
+        "once expired (its server died) the job is failed and any later write of it refused.",
+    )
     log_level: str = "INFO"
 
     @field_validator("timezone")

@@ -4,7 +4,10 @@ SQLite is tuned for a web service: write-ahead log (readers never wait for the w
 keys on, a busy timeout, and write transactions that take the write lock when they begin
 (``BEGIN IMMEDIATE``). Without the last, a transaction that reads and then writes can fail at
 once with "database is locked" when another writer committed in between, instead of waiting.
-PostgreSQL needs none of this and gets plain transactions.
+PostgreSQL gets plain READ COMMITTED transactions: there, writers that read then write lock
+the rows they change first (``repository.lock_building``: ``SELECT … FOR UPDATE``, ignored by
+SQLite, whose write lock covers the database) and counters move in one statement
+(``UPDATE … SET n = n + 1 RETURNING n``), so both databases give the same results.
 """
 
 from __future__ import annotations

@@ -6,10 +6,15 @@ from datetime import datetime
 from typing import Annotated, Any
 
 import pandas as pd
+from fastapi import Path
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo
 
 from rcengine.io.timeseries import format_times
 from rcengine.models import MODELS
+
+# Largest id: PostgreSQL's INTEGER, the narrower of the two databases' id columns. A larger id
+# in a path is refused (422 naming it) before it reaches a query the driver cannot bind.
+MAX_ID = 2**31 - 1
 
 # Key of the validation context that names the building's time zone (IANA name).
 TIMEZONE = "timezone"
@@ -32,6 +37,11 @@ def _in_building_zone(value: Any, info: ValidationInfo) -> Any:
 
 # A stored instant in an answer: ISO 8601 with the UTC offset of the building's time zone.
 LocalTime = Annotated[str, BeforeValidator(_in_building_zone)]
+
+
+def id_in_path(what: str, example: int) -> Any:
+    """A path parameter that is a stored id: 1 … MAX_ID."""
+    return Path(description=f"{what} id", examples=[example], ge=1, le=MAX_ID)
 
 
 def with_examples(*examples: dict[str, Any], **config: Any) -> ConfigDict:
@@ -84,8 +94,11 @@ class DataErrorRead(BaseModel):
 
 
 def error_responses(*codes: int) -> dict[int | str, dict]:
-    """OpenAPI entries for the error statuses a route can answer."""
+    """OpenAPI entries for the error statuses a route can answer, and those any route can: 400
+    (a body that cannot be parsed) and 422 (a parameter or body field breaking its rule; the
+    framework's own list-shaped 422 is replaced by this one, see ``api.errors``)."""
     text = {
+        400: "The body cannot be parsed",
         401: "Missing or invalid bearer token",
         403: "Not allowed with this token",
         404: "No such resource for this token (another building's resources are not found)",
@@ -96,5 +109,5 @@ def error_responses(*codes: int) -> dict[int | str, dict]:
     }
     return {
         code: {"model": DataErrorRead if code == 422 else ErrorRead, "description": text[code]}
-        for code in codes
+        for code in sorted({400, *codes, 422})
     }

@@ -58,7 +58,8 @@ class JobRead(BaseModel):
     parameter_set_id: int | None = Field(description="The set a calibration stored")
     diagnosis_id: int | None = Field(description="The report a diagnosis stored")
     options: dict[str, Any] | None = Field(
-        description="What a diagnosis was asked: window (UTC), train_fraction, effects"
+        description="What a diagnosis was asked: window (UTC), train_fraction, effects; "
+        "days_requested when fewer days are stored than a job asked for (its days are those used)"
     )
     details: dict[str, Any] | None
 

@@ -26,9 +26,11 @@ from fastapi.testclient import TestClient
 
 from rcengine.io.timeseries import format_times
 from service.core.config import Settings
+from service.core.db import Database
 from service.main import create_app
 
 from ..synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from .postgres import PostgresServer
 
 ADMIN_TOKEN = "test-admin-token-0123456789abcdef"
 ADMIN = {"Authorization": f"Bearer {ADMIN_TOKEN}"}
@@ -50,16 +52,65 @@ def json_rows(frame: pd.DataFrame, timezone: str = TIMEZONE) -> list[dict]:
     return rows
 
 
+# --- databases --------------------------------------------------------------------------------
+BACKENDS = ("sqlite", "postgresql")
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """Tests of a module with ``ON_BOTH_DATABASES = True`` run on SQLite and on PostgreSQL."""
+    if getattr(metafunc.module, "ON_BOTH_DATABASES", False) and (
+        "database_url" in metafunc.fixturenames
+    ):
+        metafunc.parametrize("backend", BACKENDS, indirect=True)
+
+
+@pytest.fixture
+def backend(request: pytest.FixtureRequest) -> str:
+    return getattr(request, "param", "sqlite")
+
+
+@pytest.fixture(scope="session")
+def postgres() -> Iterator[PostgresServer]:
+    server = PostgresServer()
+    try:
+        yield server
+    finally:
+        server.stop()
+
+
+@pytest.fixture
+def database_url(backend: str, tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[str]:
+    """A fresh empty database of the test's backend."""
+    if backend == "sqlite":
+        yield f"sqlite:///{tmp_path / 'rcservice.db'}"
+        return
+    server: PostgresServer = request.getfixturevalue("postgres")
+    name = server.create()
+    try:
+        yield server.url(name)
+    finally:
+        server.drop(name)
+
+
 # --- in-process app -------------------------------------------------------------------------
 @pytest.fixture
-def settings(tmp_path: Path) -> Settings:
+def settings(database_url: str) -> Settings:
     return Settings(
-        database_url=f"sqlite:///{tmp_path / 'rcservice.db'}",
+        database_url=database_url,
         admin_token=ADMIN_TOKEN,
         workers=0,
         scheduler_enabled=False,
         max_body_bytes=200_000,
     )
+
+
+@pytest.fixture
+def db(settings: Settings) -> Iterator[Database]:
+    """The test's database, migrated, without an app."""
+    database = Database(settings.database_url)
+    database.migrate()
+    yield database
+    database.dispose()
 
 
 @pytest.fixture

@@ -13,6 +13,9 @@ import pytest
 
 from .conftest import ADMIN, SYNTHETIC_BUILDING, json_rows, register
 
+# Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
+ON_BOTH_DATABASES = True
+
 SEED_ROWS = 8  # stored before each test: 2 h at 15 min
 
 

@@ -21,6 +21,9 @@ from service.main import create_app
 
 from .conftest import DAY, json_rows, register, wait_for_job
 
+# Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
+ON_BOTH_DATABASES = True
+
 
 def calibrate(client, building_id, headers, days=1):
     response = client.post(

@@ -327,7 +327,7 @@ def test_migration_applies_on_a_fresh_sqlite_file(tmp_path):
     assert "diagnoses" in tables.get_table_names()
     assert {"kind", "options"} <= {c["name"] for c in tables.get_columns("jobs")}
     with db.session() as session:
-        assert session.execute(text("SELECT version_num FROM alembic_version")).scalar() == "0002"
+        assert session.execute(text("SELECT version_num FROM alembic_version")).scalar() == "0003"
     db.dispose()
 
 

@@ -11,6 +11,9 @@ from rcengine.parameter_set import ParameterSet
 
 from .conftest import DAY, json_rows, register, rmse, wait_for_job
 
+# Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
+ON_BOTH_DATABASES = True
+
 
 @pytest.fixture
 def calibrated(client, measured):

@@ -16,6 +16,9 @@ from service.errors import CalibrationError, ConflictError
 from service.jobs import describe, execute, kinds
 from service.models import CALIBRATION, DIAGNOSIS, FAILED, SUCCEEDED, JobRecord
 
+# Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
+ON_BOTH_DATABASES = True
+
 
 @dataclass(frozen=True)
 class Made:

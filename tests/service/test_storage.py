@@ -25,13 +25,8 @@ from service.scheduler import JOB_ID, start_scheduler
 
 from .conftest import json_rows, register
 
-
-@pytest.fixture
-def db(settings):
-    database = Database(settings.database_url)
-    database.migrate()
-    yield database
-    database.dispose()
+# Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
+ON_BOTH_DATABASES = True
 
 
 def test_migration_creates_exactly_the_tables_of_the_models(db):
@@ -40,7 +35,9 @@ def test_migration_creates_exactly_the_tables_of_the_models(db):
     assert differences == []
 
 
-def test_sqlite_runs_in_wal_with_foreign_keys_and_a_busy_timeout(db):
+def test_sqlite_runs_in_wal_with_foreign_keys_and_a_busy_timeout(db, backend):
+    if backend != "sqlite":
+        pytest.skip("SQLite settings")
     with db.session() as session:
         assert session.execute(text("PRAGMA journal_mode")).scalar() == "wal"
         assert session.execute(text("PRAGMA foreign_keys")).scalar() == 1

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Path, status
+from fastapi import APIRouter, status
 
 from rcengine.building import Building
 
@@ -17,7 +17,7 @@ from ...schemas.buildings import (
     BuildingRead,
     TokenRotated,
 )
-from ...schemas.common import error_responses, in_zone
+from ...schemas.common import error_responses, id_in_path, in_zone
 from ..deps import AdminDep, BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["buildings"])
@@ -80,7 +80,7 @@ def read_building(building_id: BuildingDep, ctx: ContextDep) -> BuildingRead:
     responses=error_responses(401, 403, 404),
 )
 def rotate_token(
-    building_id: Annotated[int, Path(description="Building id", examples=[1])],
+    building_id: Annotated[int, id_in_path("Building", 1)],
     ctx: ContextDep,
     _: AdminDep,
 ) -> TokenRotated:

@@ -6,10 +6,11 @@ from functools import lru_cache
 from typing import Annotated, TypeVar
 
 import numpy as np
-from fastapi import APIRouter, HTTPException, Query, status
+from fastapi import APIRouter, Query
 from fastapi.concurrency import run_in_threadpool
 
-from rcengine.columns import COLUMNS
+from rcengine.columns import COLUMNS, Q_HVAC
+from rcengine.exceptions import DataValidationError, Problem
 from rcengine.io.instants import parse_instant
 
 from ...forecasting import Prediction, SetInfo
@@ -78,14 +79,7 @@ async def forecast(
     responses=error_responses(401, 404, 409, 422),
 )
 def simulate(building_id: BuildingDep, body: SimulateRequest, ctx: ContextDep) -> SimulateRead:
-    candidates = np.atleast_2d(np.asarray(body.q_hvac, dtype=float))
-    if candidates.ndim != 2 or candidates.shape[1] == 0 or len(candidates) > MAX_CANDIDATES:
-        raise HTTPException(
-            status.HTTP_422_UNPROCESSABLE_CONTENT,
-            f"q_hvac must be 1 to {MAX_CANDIDATES} candidates of equal, non-zero length",
-        )
-    if not np.isfinite(candidates).all():
-        raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, "q_hvac must be finite")
+    candidates = _candidates(body.q_hvac)
     first = None if body.start is None else parse_instant(body.start, "start")
     prediction, outputs = ctx.forecaster.simulate(building_id, first, candidates)
     return _trajectories(SimulateRead, prediction, t_in=outputs.tolist())
@@ -137,6 +131,34 @@ def model(
         },
         context=in_zone(result.timezone),
     )
+
+
+def _candidates(q_hvac: list[list[float]] | list[float]) -> np.ndarray:
+    """The candidates as an N × H array; 422 naming q_hvac unless 1 … MAX_CANDIDATES
+    trajectories of one non-zero length with every value within the contract's range of q_hvac.
+    """
+    rows = [q_hvac] if not q_hvac or not isinstance(q_hvac[0], list) else q_hvac
+    lengths = {len(row) for row in rows}
+    if not 1 <= len(rows) <= MAX_CANDIDATES or len(lengths) != 1 or 0 in lengths:
+        raise _bad_q_hvac(
+            f"1 to {MAX_CANDIDATES} candidates of equal, non-zero length (got {len(rows)} "
+            f"of length(s) {sorted(lengths)[:5]})"
+        )
+    candidates = np.asarray(rows, dtype=float)
+    low, high = COLUMNS[Q_HVAC].lower, COLUMNS[Q_HVAC].upper
+    with np.errstate(invalid="ignore"):
+        inside = (candidates >= low) & (candidates <= high)
+    if not inside.all():
+        n, k = np.argwhere(~inside)[0]
+        raise _bad_q_hvac(
+            f"finite values within [{low:g}, {high:g}] W; candidate {n}, step {k} is "
+            f"{candidates[n, k]:g} W"
+        )
+    return candidates
+
+
+def _bad_q_hvac(needed: str) -> DataValidationError:
+    return DataValidationError([Problem(None, Q_HVAC, f"q_hvac must be {needed}")])
 
 
 def _trajectories(schema: type[Trajectories], prediction: Prediction, **t_in: list) -> Trajectories:

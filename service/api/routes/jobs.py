@@ -5,11 +5,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Annotated
 
-from fastapi import APIRouter, HTTPException, Path, status
+from fastapi import APIRouter, HTTPException, status
 
 from ... import repository
 from ...models import CALIBRATION, DIAGNOSIS
-from ...schemas.common import error_responses
+from ...schemas.common import error_responses, id_in_path
 from ...schemas.jobs import JobList, JobRead
 from ..answers import building_zone, job_read
 from ..deps import BuildingDep, ContextDep, TokenBuildingDep
@@ -27,7 +27,7 @@ JOBS_LISTED = 100
     tags=["jobs"],
 )
 def read_job(
-    job_id: Annotated[int, Path(examples=[12])], ctx: ContextDep, owner: TokenBuildingDep
+    job_id: Annotated[int, id_in_path("Job", 12)], ctx: ContextDep, owner: TokenBuildingDep
 ) -> JobRead:
     with ctx.db.session() as session:
         job = repository.get_job(session, job_id)

@@ -4,16 +4,16 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Path
+from fastapi import APIRouter
 
 from ... import repository
-from ...schemas.common import error_responses
+from ...schemas.common import error_responses, id_in_path
 from ...schemas.parameters import ParameterSetList, ParameterSetRead
 from ..answers import building_zone
 from ..deps import BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["parameters"])
-SetId = Annotated[int, Path(description="Parameter-set id", examples=[4])]
+SetId = Annotated[int, id_in_path("Parameter-set", 4)]
 
 
 @router.get(
