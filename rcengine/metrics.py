@@ -30,7 +30,15 @@ def _pairs(measured: ArrayLike, simulated: ArrayLike) -> tuple[np.ndarray, np.nd
 def rmse(measured: ArrayLike, simulated: ArrayLike) -> float:
     """Root-mean-square error, thesis Eq. 19. [same unit as input, K for temperatures]"""
     y, y_hat = _pairs(measured, simulated)
-    return float(np.sqrt(np.mean((y - y_hat) ** 2)))
+    error = y - y_hat
+    with np.errstate(over="ignore"):
+        value = np.sqrt(np.mean(error**2))
+    if np.isinf(value):
+        # Errors beyond ~1e154 (an absurd prediction) overflow when squared; scaled by the
+        # largest one, the same RMSE stays finite wherever it is representable.
+        scale = np.max(np.abs(error))
+        value = scale * np.sqrt(np.mean((error / scale) ** 2))
+    return float(value)
 
 
 def mbe(measured: ArrayLike, simulated: ArrayLike) -> float:

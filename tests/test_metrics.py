@@ -1,5 +1,7 @@
 """Metrics against hand-computed values (thesis Eq. 19–20, ASHRAE Guideline 14)."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -30,3 +32,11 @@ def test_ashrae_guideline_14_limits():
     assert not evaluate(y, y + 2.5).ashrae14_pass  # NMBE −12.5 % breaks the ±10 % limit
     m = evaluate(y, y + 0.5).to_dict()
     assert set(m) == {"rmse", "mbe", "nmbe", "cv_rmse", "n", "ashrae14_pass"}
+
+
+def test_rmse_of_an_absurd_prediction_is_finite_and_exact():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warning on the way
+        value = rmse([20.0, 21.0], [7e304, 20.0])
+    assert np.isfinite(value)
+    assert value == pytest.approx(7e304 / np.sqrt(2.0), rel=1e-12)
