@@ -7,7 +7,7 @@
 - ``diagnose DATA -b BUILDING [-m MODEL --json REPORT --html REPORT --train-fraction --seed]``:
   locate the model–data mismatch and name the missing physics;
 - ``study DATA -b BUILDING -o FOLDER [--freefloat --models --start --end --workers --preset
-  --seed]``: the thesis's rolling learn/predict study.
+  --seed --criterion]``: the thesis's rolling learn/predict study.
 
 Every ``--start``/``--end`` is an ISO 8601 time with a UTC offset or a local date in the
 building's time zone (``rcengine.io.instants``). Engine errors and bad values end in one line,
@@ -261,6 +261,9 @@ def study(
     workers: Annotated[int, typer.Option(help="processes (0: every core)")] = 0,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "study",
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    criterion: Annotated[
+        str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
+    ] = "output_error",
 ) -> None:
     """The thesis's rolling learn/predict study: tables, summary.json and figures."""
     import os
@@ -271,6 +274,8 @@ def study(
 
     if preset not in PRESETS:
         fail(f"invalid preset {preset!r}; choose from {sorted(PRESETS)}")
+    if criterion not in CRITERIA:
+        fail(f"invalid criterion {criterion!r}; choose from {list(CRITERIA)}")
 
     def run() -> None:
         started = time.perf_counter()
@@ -284,6 +289,7 @@ def study(
             end=last,
             workers=workers or os.cpu_count() or 1,
             random_state=seed,
+            criterion=criterion,
         )
         with progress_bar() as progress:
             results = run_study(frame, b, settings, progress)

@@ -87,7 +87,9 @@ def parameter_set_record(
     pset: ParameterSet, building_id: int, job_id: int | None, reason: str | None
 ) -> ParameterSetRecord:
     """A row holding ``pset`` (status and ``is_current`` are set when it is stored)."""
-    document = json.loads(json.dumps(pset.to_dict(), default=jsonable))
+    # Strict JSON as ParameterSet.save writes it: non-finite floats (e.g. the standard error of
+    # a non-identifiable parameter of a likelihood fit) become null; PostgreSQL refuses NaN.
+    document = json.loads(json.dumps(jsonable(pset.to_dict()), allow_nan=False))
     holdout = pset.metrics.get("holdout") or {}
     return ParameterSetRecord(
         building_id=building_id,

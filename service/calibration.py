@@ -55,6 +55,7 @@ class CalibrationOptions:
     preset: str = "default"
     random_state: int = 0
     holdout_h: float = HOLDOUT_H
+    criterion: str = "output_error"
 
 
 @dataclass(frozen=True)
@@ -165,7 +166,12 @@ def fit_parameter_set(
     """The engine's GA + GPS fit of ``model`` on the training rows."""
     network = get_model(model, building, training.columns)
     data = prepare(training, building, network.compile().input_names)
-    estimator = Estimator(network, preset=options.preset, random_state=options.random_state)
+    estimator = Estimator(
+        network,
+        preset=options.preset,
+        random_state=options.random_state,
+        criterion=options.criterion,
+    )
     estimator.fit(data)
     return ParameterSet.from_estimator(estimator, data, building, model)
 
@@ -176,7 +182,9 @@ def holdout_forecast(
     """The held-out rows and the set's day-ahead forecast of their ``t_in``. [°C]"""
     hours = (window.end - window.holdout_start).total_seconds() / 3600.0
     data = pset.prepare(frame)
-    predicted = forecast(pset.compiled, pset.values, data, window.holdout_start, hours)
+    predicted = forecast(
+        pset.compiled, pset.values, data, window.holdout_start, hours, noise=pset.noise
+    )
     return frame.reindex(predicted.times), predicted.t_in_pred
 
 

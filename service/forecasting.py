@@ -26,6 +26,7 @@ from rcengine.forecast import (
     trajectories,
 )
 from rcengine.io.timeseries import format_times
+from rcengine.kalman import Noise
 from rcengine.network import CompiledNetwork
 from rcengine.parameter_set import ParameterSet
 from rcengine.statespace import DiscreteStateSpace
@@ -72,18 +73,21 @@ class LoadedSet:
     info: SetInfo
     pset: ParameterSet
     compiled: CompiledNetwork
+    noise: Noise | None
 
 
 @dataclass(frozen=True)
 class Prediction:
-    """A forecast: UTC and local times, t_in_pred [°C], the start state [°C], the discrete
-    model and the dataset it ran on."""
+    """A forecast: UTC and local times, t_in_pred [°C], its standard deviation t_in_std [K]
+    (the set's fitted noise model, else the filter's fixed defaults), the start state [°C], the
+    discrete model and the dataset it ran on."""
 
     parameter_set: SetInfo
     timezone: str
     times: pd.DatetimeIndex
     local_times: list[str]
     t_in_pred: np.ndarray
+    t_in_std: np.ndarray
     state0: np.ndarray
     model: DiscreteStateSpace
     data: Dataset
@@ -196,13 +200,16 @@ class Forecaster:
         loaded = self._loaded(building_id, set_id)
         _require_rows(frame, first, end)
         data = loaded.pset.prepare(frame)
-        result = forecast(loaded.compiled, loaded.pset.values, data, start, hours, self.history_h)
+        result = forecast(
+            loaded.compiled, loaded.pset.values, data, start, hours, self.history_h, loaded.noise
+        )
         return Prediction(
             loaded.info,
             timezone,
             result.times,
             format_times(result.times, timezone),
             result.t_in_pred,
+            result.t_in_std,
             result.state0,
             result.model,
             data,
@@ -213,7 +220,7 @@ class Forecaster:
             with self.db.session() as session:
                 record = repository.get_parameter_set(session, building_id, set_id)
                 pset = bridge.parameter_set_of(record)
-                return LoadedSet(SetInfo.of(record), pset, pset.compiled)
+                return LoadedSet(SetInfo.of(record), pset, pset.compiled, pset.noise)
 
         return self._sets.get_or_compute(set_id, load)
 

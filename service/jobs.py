@@ -72,7 +72,12 @@ Work = Callable[[Database, JobRecord, Any], Product]
 def kinds(settings: Settings) -> dict[str, tuple[Work, Any]]:
     """The work of each kind of job and the service settings it receives (picklable)."""
     return {
-        CALIBRATION: (calibration.work, CalibrationOptions(settings.preset, settings.random_state)),
+        CALIBRATION: (
+            calibration.work,
+            CalibrationOptions(
+                settings.preset, settings.random_state, criterion=settings.criterion
+            ),
+        ),
         DIAGNOSIS: (
             diagnosis.work,
             DiagnosisOptions(settings.diagnosis_preset, settings.random_state),

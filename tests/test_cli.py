@@ -281,6 +281,26 @@ def test_study_reads_instants_and_local_dates_alike(workdir, monkeypatch, form):
     assert settings.end == pd.Timestamp(OFFICE_FIT[1])
 
 
+@pytest.mark.parametrize("criterion", [None, "likelihood"], ids=["default", "likelihood"])
+def test_study_passes_the_criterion(workdir, monkeypatch, criterion):
+    """--criterion reaches the study's settings; without it the study keeps output error (the
+    published figures); an unknown criterion is refused (run and writing stubbed)."""
+    import rcengine.study.report
+    import rcengine.study.run
+
+    seen, frame = {}, pd.DataFrame()
+    monkeypatch.setattr(
+        rcengine.study.run, "run_study", lambda *args: seen.setdefault("s", args[2]) and frame
+    )
+    monkeypatch.setattr(rcengine.study.report, "write_study", lambda *args: [])
+    args = ["study", "data.csv", "--building", "b.json", "-o", "out", "--workers", "1"]
+    result = invoke(*args, *([] if criterion is None else ["--criterion", criterion]))
+    assert result.exit_code == 0, result.output
+    assert seen["s"].criterion == (criterion or "output_error")
+    refused = invoke(*args, "--criterion", "bogus")
+    assert refused.exit_code == 2 and "invalid criterion 'bogus'" in refused.output
+
+
 def date_commands(start: str, end: str | None = None) -> dict[str, list[str]]:
     """Each command with date options, its --start (and --end) set; outputs p.json, f.csv, out."""
     fit = ["fit", "data.csv", "--building", "b.json", "--model", "basic", "-o", "p.json"]

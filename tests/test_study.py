@@ -4,6 +4,7 @@ the persistence baseline computed by hand, and the learned models beating it."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -168,3 +169,19 @@ def test_figures_written(written):
 @pytest.mark.parametrize(("index", "name"), [(0.2, "overcast"), (0.55, "mixed"), (0.95, "sunny")])
 def test_sky_class(index, name):
     assert sky_class(index) == name
+
+
+def test_likelihood_criterion_gives_finite_tables(office, settings):
+    """The study with the maximum-likelihood criterion on a sub-period (the short study's
+    settings, one model, the complete period): every training and validation RMSE is finite."""
+    heating, _, building = office
+    short = replace(settings, models=("basic",), periods=("complete",), criterion="likelihood")
+    results = run_study(heating, building, short)
+    assert len(results) == len(COMPLETE_DAYS) * len(short.learn_days)
+    out = tables(results, short)
+    train = out["training_rmse_basic_complete"]
+    valid = out["validation_rmse_basic_complete"]
+    assert list(train.index) == COMPLETE_DAYS and list(valid.index) == COMPLETE_DAYS
+    assert valid.shape[1] == len(short.learn_days) * len(short.horizons)
+    assert np.isfinite(train.to_numpy()).all() and np.isfinite(valid.to_numpy()).all()
+    assert (valid.to_numpy() > 0).all()

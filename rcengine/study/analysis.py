@@ -197,9 +197,11 @@ def free_floating(
     predict_days: int = 12,
     start: str = "2017-02-01",
     preset: str | EstimatorSettings = "study",
+    criterion: str = "output_error",
 ) -> dict:
-    """Thesis §3.3: learn on the ``learn_days`` before ``start`` of a free-floating record and
-    predict ``predict_days``; RMSE, MBE, NMBE ("MBS"), CV(RMSE) and ASHRAE Guideline 14."""
+    """Thesis §3.3: learn on the ``learn_days`` before ``start`` of a free-floating record (by the
+    estimator's ``criterion``) and predict ``predict_days``; RMSE, MBE, NMBE ("MBS"), CV(RMSE)
+    and ASHRAE Guideline 14."""
     data = prepared(frame, building, model)
     tz = building.location.timezone
     day0 = pd.Timestamp(start).tz_localize(tz)
@@ -207,8 +209,8 @@ def free_floating(
     net = get_model(model, building, frame.columns)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(net, preset=preset, random_state=0).fit(train)
-    fc = forecast(est.compiled, est.params_, data, day0, hours=24 * predict_days)
+        est = Estimator(net, preset=preset, random_state=0, criterion=criterion).fit(train)
+    fc = forecast(est.compiled, est.params_, data, day0, hours=24 * predict_days, noise=est.noise_)
     measured = data.frame[T_IN].reindex(fc.times).to_numpy(dtype=float)
     metrics = evaluate(measured, fc.t_in_pred).to_dict()
     return {

@@ -124,14 +124,13 @@ def _free_floating(
     out: dict = {"thesis": THESIS_FREE_FLOATING}
     written = []
     for model in settings.models:
-        ff = free_floating(free, building, model, start=FREE_FLOATING_START, preset=settings.preset)
+        fit = {"preset": settings.preset, "criterion": settings.criterion}
+        ff = free_floating(free, building, model, start=FREE_FLOATING_START, **fit)
         out[model] = {
             k: ff[k] for k in ("model", "learn_days", "predict_days", "start", "metrics", "params")
         }
         out[model]["other_starts"] = {
-            start: free_floating(free, building, model, start=start, preset=settings.preset)[
-                "metrics"
-            ]
+            start: free_floating(free, building, model, start=start, **fit)["metrics"]
             for start in FREE_FLOATING_OTHER_STARTS
         }
         name = "fig3_9_free_floating" if model == "basic" else f"free_floating_{model}"

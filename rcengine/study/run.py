@@ -28,6 +28,7 @@ from rcengine.estimation import Estimator, EstimatorSettings
 from rcengine.exceptions import ConvergenceWarning
 from rcengine.forecast import forecast
 from rcengine.io.instants import parse_instant
+from rcengine.kalman import Noise
 from rcengine.metrics import rmse
 from rcengine.models import get_model
 from rcengine.parallel import process_pool
@@ -40,7 +41,8 @@ PERIODS = ("complete", "selected")
 class StudySettings:
     """models, learning lengths [d], horizons [d], estimator preset; start ≤ day < end restrict
     the days predicted (instants, or local dates: ``parse_instant``); workers: processes (default:
-    every core)."""
+    every core); criterion: the estimator's ("output_error", the published figures, or
+    "likelihood", whose fitted noise model then also sets the forecasts' start state)."""
 
     models: tuple[str, ...] = ("basic", "sun")
     periods: tuple[str, ...] = PERIODS
@@ -51,6 +53,7 @@ class StudySettings:
     end: str | pd.Timestamp | None = None
     workers: int = field(default_factory=lambda: os.cpu_count() or 1)
     random_state: int = 0
+    criterion: str = "output_error"
 
 
 @dataclass(frozen=True)
@@ -95,10 +98,15 @@ def _window(
 
 
 def _forecast_days(
-    compiled, params: dict, data: Dataset, chosen: list[pd.Timestamp]
+    compiled,
+    params: dict,
+    data: Dataset,
+    chosen: list[pd.Timestamp],
+    noise: Noise | None = None,
 ) -> tuple[pd.DatetimeIndex, np.ndarray, np.ndarray]:
     """Times, predicted and measured t_in over ``chosen`` days; each run of consecutive days is
-    one forecast from the Kalman state at its start."""
+    one forecast from the Kalman state at its start (``noise``: the fitted noise model, None for
+    the filter's defaults)."""
     runs, current = [], [chosen[0]]
     for day in chosen[1:]:
         if day - current[-1] == pd.Timedelta(days=1):
@@ -109,7 +117,7 @@ def _forecast_days(
     runs.append(current)
     times, predicted, measured = [], [], []
     for run in runs:
-        fc = forecast(compiled, params, data, run[0], hours=24 * len(run))
+        fc = forecast(compiled, params, data, run[0], hours=24 * len(run), noise=noise)
         times.append(fc.times)
         predicted.append(fc.t_in_pred)
         measured.append(data.frame[T_IN].reindex(fc.times).to_numpy(dtype=float))
@@ -135,15 +143,20 @@ def learn_and_predict(
     ahead: list[pd.Timestamp],
     preset: str | EstimatorSettings,
     random_state: int,
+    criterion: str = "output_error",
 ) -> Prediction:
-    """Fit on the ``past`` days, forecast the ``ahead`` days."""
+    """Fit on the ``past`` days by ``criterion``, forecast the ``ahead`` days."""
     # CPU time beside wall time: other processes sharing the cores inflate only the latter.
     started, started_cpu = time.perf_counter(), time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(network, preset=preset, random_state=random_state).fit(data.on_days(past))
+        est = Estimator(
+            network, preset=preset, random_state=random_state, criterion=criterion
+        ).fit(data.on_days(past))
     wall, cpu = time.perf_counter() - started, time.process_time() - started_cpu
-    times, predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead)
+    times, predicted, measured = _forecast_days(
+        est.compiled, est.params_, data, ahead, est.noise_
+    )
     return Prediction(est, wall, cpu, times, predicted, measured)
 
 
@@ -175,7 +188,9 @@ def run_task(task: Task) -> list[dict]:
         past = _window(days, task.day, learn, task.period, before=True)
         if past is None or ahead is None or yesterday is None:
             continue
-        p = learn_and_predict(data, net, past, ahead, settings.preset, settings.random_state)
+        p = learn_and_predict(
+            data, net, past, ahead, settings.preset, settings.random_state, settings.criterion
+        )
         naive = persistence(data, yesterday[0], p.times, building.location.timezone)
         row = {
             "model": task.model,

@@ -9,6 +9,7 @@ from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
 
+from rcengine.estimation.estimator import CRITERIA
 from rcengine.estimation.presets import PRESETS
 from rcengine.models import MODELS
 
@@ -46,6 +47,12 @@ class Settings(BaseSettings):
     model: str = Field("basic", description="Default model of the rcengine library.")
     preset: str = Field("default", description="Estimator preset of rcengine.estimation.estimator.")
     random_state: int = 0
+    criterion: str = Field(
+        "output_error",
+        description="Calibration criterion of rcengine.estimation.estimator: 'output_error' "
+        "(open-loop simulation error) or 'likelihood' (Kalman maximum likelihood; the stored "
+        "set then carries its fitted noise model, used by the forecast's t_in_std).",
+    )
     diagnosis_days: int = Field(
         182,
         ge=2,
@@ -97,6 +104,13 @@ class Settings(BaseSettings):
     def _known_preset(cls, value: str | None) -> str | None:
         if value is not None and value not in PRESETS:
             raise ValueError(f"invalid preset {value!r}; choose from {sorted(PRESETS)}")
+        return value
+
+    @field_validator("criterion")
+    @classmethod
+    def _known_criterion(cls, value: str) -> str:
+        if value not in CRITERIA:
+            raise ValueError(f"invalid criterion {value!r}; choose from {list(CRITERIA)}")
         return value
 
     @field_validator("admin_token")

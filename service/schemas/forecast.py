@@ -42,6 +42,7 @@ class ForecastRead(BaseModel):
         {
             "times": TIMES_EXAMPLE,
             "t_in_pred": [20.61, 20.55],
+            "t_in_std": [0.12, 0.15],
             "parameter_set": SET_REF_EXAMPLE,
             "step_s": 900.0,
             "unit": "°C",
@@ -50,6 +51,11 @@ class ForecastRead(BaseModel):
 
     times: list[str]
     t_in_pred: list[float] = Field(description="[°C]")
+    t_in_std: list[float] = Field(
+        description="Standard deviation of the measured t_in about t_in_pred, per row [K]: the "
+        "set's fitted noise model when it has one (likelihood criterion), else the Kalman "
+        "filter's fixed defaults (nominal only); parameter uncertainty not included"
+    )
     parameter_set: ParameterSetRef
     step_s: float = Field(description="[s]")
     unit: str = "°C"

@@ -5,9 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from fastapi.testclient import TestClient
 
 from rcengine.forecast import forecast
 from rcengine.parameter_set import ParameterSet
+from service.main import create_app
 
 from .conftest import DAY, json_rows, register, rmse, wait_for_job
 
@@ -46,6 +48,24 @@ def test_forecast_matches_the_engine_and_the_truth(
     assert body["times"][0] == "2017-01-12T01:00:00+01:00"
     assert body["times"][-1] == "2017-01-13T00:45:00+01:00" and len(body["times"]) == DAY
     assert body["step_s"] == 900.0 and body["unit"] == "°C"
+
+
+def test_forecast_carries_its_standard_deviation(client, calibrated, three_days_measured):
+    """t_in_std beside t_in_pred (CONTRACT.md §4 extended): one per row, positive, finite,
+    growing over the horizon, and the engine's own figure for the stored set's noise model."""
+    building_id, headers = calibrated
+    body = get_forecast(client, building_id, headers, start="2017-01-12T01:00:00+01:00").json()
+    std = np.asarray(body["t_in_std"])
+    assert len(std) == len(body["t_in_pred"]) == len(body["times"])
+    assert np.isfinite(std).all() and (std > 0).all()
+    assert np.mean(np.diff(std)) >= 0 and std[-1] > std[0]
+    set_id = body["parameter_set"]["id"]
+    document = client.get(f"/buildings/{building_id}/parameters/{set_id}/document", headers=headers)
+    pset = ParameterSet.from_dict(document.json())
+    data = pset.prepare(three_days_measured)
+    start = pd.Timestamp("2017-01-12T00:00:00Z")
+    expected = forecast(pset.compiled, pset.values, data, start, hours=24, noise=pset.noise)
+    np.testing.assert_allclose(std, expected.t_in_std, rtol=1e-12, atol=0)
 
 
 def test_default_start_is_one_step_after_the_last_measurement(client, calibrated):
@@ -219,3 +239,31 @@ def test_building_summary_reports_grid_and_last_measurement(client, calibrated):
     assert summary["first_time"] == "2017-01-09T01:00:00+01:00"
     assert summary["last_measured_time"] == "2017-01-12T00:45:00+01:00"
     assert summary["current_parameter_set_id"] is not None
+
+
+def test_likelihood_criterion_stores_and_serves_the_fitted_noise(settings, three_days_measured):
+    """RCSERVICE_CRITERION=likelihood: the calibration fits by maximum likelihood, the set keeps
+    its noise model, and the forecast's t_in_std is the engine's figure for that model."""
+    chosen = settings.model_copy(update={"criterion": "likelihood"})
+    with TestClient(create_app(chosen)) as client:
+        building_id, headers = register(client)
+        rows = {"rows": json_rows(three_days_measured)}
+        client.post(f"/buildings/{building_id}/measurements", json=rows, headers=headers)
+        job = client.post(
+            f"/buildings/{building_id}/calibrations", json={"days": 1}, headers=headers
+        )
+        finished = wait_for_job(client, job.json()["id"], headers)
+        assert finished["outcome"] == "promoted", finished["error"]
+        start = "2017-01-12T01:00:00+01:00"
+        body = get_forecast(client, building_id, headers, start=start, hours=12).json()
+        set_id = body["parameter_set"]["id"]
+        document = client.get(
+            f"/buildings/{building_id}/parameters/{set_id}/document", headers=headers
+        ).json()
+    pset = ParameterSet.from_dict(document)
+    assert pset.fit["criterion"] == "likelihood" and pset.noise is not None
+    data = pset.prepare(three_days_measured)
+    expected = forecast(pset.compiled, pset.values, data, start, hours=12, noise=pset.noise)
+    np.testing.assert_allclose(body["t_in_std"], expected.t_in_std, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(body["t_in_pred"], expected.t_in_pred, rtol=0, atol=1e-9)
+    assert np.isfinite(body["t_in_std"]).all() and min(body["t_in_std"]) > 0

@@ -46,7 +46,10 @@ StartQuery = Annotated[
     description=(
         "The unmeasured states at `start` come from a Kalman filter over the measurements "
         "before it; the inputs over the horizon are the rows already uploaded for it (weather "
-        "forecast, planned q_hvac). Missing future inputs: 422 naming the columns and times. "
+        "forecast, planned q_hvac). `t_in_std`: the standard deviation of the measured t_in "
+        "about `t_in_pred` [K], from the set's fitted noise model (likelihood criterion), else "
+        "the filter's fixed defaults (then only nominal); parameter uncertainty is not included. "
+        "Missing future inputs: 422 naming the columns and times. "
         "No current parameter set: 409."
     ),
     responses=error_responses(401, 404, 409, 422),
@@ -64,7 +67,12 @@ async def forecast(
     prediction = ctx.forecaster.cached(building_id, first, hours)
     if prediction is None:
         prediction = await run_in_threadpool(ctx.forecaster.forecast, building_id, first, hours)
-    return _trajectories(ForecastRead, prediction, t_in_pred=prediction.t_in_pred.tolist())
+    return _trajectories(
+        ForecastRead,
+        prediction,
+        t_in_pred=prediction.t_in_pred.tolist(),
+        t_in_std=prediction.t_in_std.tolist(),
+    )
 
 
 @router.post(
