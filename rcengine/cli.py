@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, NoReturn
 
@@ -26,8 +27,8 @@ import pandas as pd
 import typer
 
 from rcengine.building import Building
-from rcengine.estimation import PRESETS, Estimator
-from rcengine.estimation.estimator import CRITERIA
+from rcengine.estimation import PRESETS, Estimator, settings_for
+from rcengine.estimation.estimator import CRITERIA, check_criterion
 from rcengine.estimation.likelihood import LikelihoodFit
 from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
 from rcengine.forecast import forecast
@@ -53,6 +54,14 @@ WHEN = "ISO 8601 with UTC offset, or a local date in the building's time zone"
 def fail(message: str) -> NoReturn:
     typer.secho(f"error: {message}", fg=typer.colors.RED, err=True)
     raise typer.Exit(code=2)
+
+
+def _check(check: Callable[[str], object], value: str) -> None:
+    """Refuse an invalid option value before any work, with the engine's own message."""
+    try:
+        check(value)
+    except ValueError as exc:
+        fail(str(exc))
 
 
 def _run(fn):
@@ -101,8 +110,7 @@ def fit(
 ) -> None:
     """Calibrate MODEL on DATA and write the parameter set as JSON."""
 
-    if criterion not in CRITERIA:
-        fail(f"invalid criterion {criterion!r}; choose from {list(CRITERIA)}")
+    _check(check_criterion, criterion)
 
     def run() -> None:
         b = Building.from_json(building)
@@ -272,10 +280,8 @@ def study(
     from rcengine.study.report import write_study
     from rcengine.study.run import StudySettings, progress_bar, run_study
 
-    if preset not in PRESETS:
-        fail(f"invalid preset {preset!r}; choose from {sorted(PRESETS)}")
-    if criterion not in CRITERIA:
-        fail(f"invalid criterion {criterion!r}; choose from {list(CRITERIA)}")
+    _check(settings_for, preset)
+    _check(check_criterion, criterion)
 
     def run() -> None:
         started = time.perf_counter()

@@ -41,6 +41,18 @@ from rcengine.parallel import one_blas_thread
 CRITERIA = ("output_error", "likelihood")
 
 
+def check_criterion(criterion: str) -> str:
+    """``criterion`` if it is one of :data:`CRITERIA`.
+
+    Raises
+    ------
+    ModelError : naming the choices.
+    """
+    if criterion not in CRITERIA:
+        raise ModelError(f"invalid criterion {criterion!r}; choose from {list(CRITERIA)}")
+    return criterion
+
+
 @dataclass(frozen=True)
 class Identifiability:
     """singular_ratios: σ_k/σ_max of the relative-sensitivity Jacobian (keyed by the free parameter
@@ -139,8 +151,7 @@ class Estimator:
     def fit(self, data: Dataset) -> Estimator:
         """Estimate the parameters on ``data`` (every segment, measured ``t_in``); returns self."""
         started = time.perf_counter()
-        if self.criterion not in CRITERIA:
-            raise ModelError(f"invalid criterion {self.criterion!r}; choose from {CRITERIA}")
+        check_criterion(self.criterion)
         settings = self._settings()
         network = self.compiled
         space = SearchSpace(network, self.known, self.bounds)

@@ -9,8 +9,8 @@ from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
 
-from rcengine.estimation.estimator import CRITERIA
-from rcengine.estimation.presets import PRESETS
+from rcengine.estimation.estimator import check_criterion
+from rcengine.estimation.presets import settings_for
 from rcengine.models import MODELS
 
 # A shorter admin token is guessable; generated tokens have 43 characters.
@@ -102,16 +102,14 @@ class Settings(BaseSettings):
     @field_validator("preset", "diagnosis_preset")
     @classmethod
     def _known_preset(cls, value: str | None) -> str | None:
-        if value is not None and value not in PRESETS:
-            raise ValueError(f"invalid preset {value!r}; choose from {sorted(PRESETS)}")
+        if value is not None:
+            settings_for(value)
         return value
 
     @field_validator("criterion")
     @classmethod
     def _known_criterion(cls, value: str) -> str:
-        if value not in CRITERIA:
-            raise ValueError(f"invalid criterion {value!r}; choose from {list(CRITERIA)}")
-        return value
+        return check_criterion(value)
 
     @field_validator("admin_token")
     @classmethod
