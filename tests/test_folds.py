@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rcengine.diagnose.fitting import trust_region
 from rcengine.diagnose.folds import (
     FoldEvidence,
     FoldRule,
@@ -13,6 +14,7 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
+from rcengine.network import Parameter, RCNetwork
 
 TZ = "Europe/Rome"
 
@@ -83,3 +85,19 @@ def test_head_to_head_names_the_winner_and_the_margin():
     assert winner == 0
     assert "better in 1 of 4 folds" in why
     assert head_to_head(weak, strong)[0] == 1
+
+
+def test_a_fold_refit_stays_near_the_fit_on_the_training_half():
+    """Positive parameters within a factor, the others within a share of their range either
+    side, always inside the network's own bounds."""
+    net = RCNetwork("chain")
+    net.add_parameter(Parameter("r_env", "K/W", 1e-3, 1.0, "envelope"))
+    net.add_parameter(Parameter("c_air", "J/K", 1e5, 1e8, "air"))
+    net.add_parameter(Parameter("q_ground", "W/m²", -20.0, 60.0, "soil"))
+    region = trust_region(net, {"r_env": 0.5, "c_air": 2e5, "q_ground": 50.0}, factor=4.0)
+    assert region["r_env"] == pytest.approx((0.125, 1.0))  # clipped at the upper bound
+    assert region["c_air"] == pytest.approx((1e5, 8e5))  # clipped at the lower bound
+    assert region["q_ground"] == pytest.approx((30.0, 60.0))  # ± 80/4 W/m², clipped
+    for name, (low, high) in region.items():
+        p = net.parameters[name]
+        assert p.lower <= low < high <= p.upper

@@ -5,15 +5,18 @@ capacity not learnt as a schedule."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from rcengine.building import Building
 from rcengine.columns import T_GROUND, UNIT
 from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
+from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.response import node_responses
 from rcengine.models import get_model
@@ -72,10 +75,9 @@ def _built(effect: str, gain_context: Context, loss_context: Context) -> Extensi
 
 
 def _window(ext: Extension, g: float) -> dict[str, float]:
-    """g − 0.1 to the mass of every orientation, 0.1 to the air: implied g-value g; glazing of
-    U = 3.3 W/(m²K)."""
-    to_mass = {p: g - 0.1 for p in ext.new_parameters if p.startswith("g_window_")}
-    return {**to_mass, "g_window_air": 0.1, "r_window": 0.3}
+    """An extra g-value ``g`` on every orientation (the context's model has no declared glazing:
+    the implied g-value is ``g``)."""
+    return dict.fromkeys(ext.new_parameters, g)
 
 
 def _ground(ext: Extension, u_floor: float, t_ground: float) -> dict[str, float]:
@@ -100,7 +102,8 @@ CASES = {
     "window_solar_gains": Case(
         lambda e: _window(e, 0.6),
         lambda e: {**_window(e, 0.6), "g_window_225_90": 1.3},
-        "implied g-value of the south-west glazing: 1.4 exceeds any glazing (≤ 0.87)",
+        "implied g-value of the south-west glazing (12 m² declared): 1.3 exceeds any facade "
+        "glazed whole with clear glass (≤ 0.87)",
     ),
     "opaque_solar_gains": Case(
         lambda e: dict.fromkeys(e.new_parameters, 0.6),
@@ -168,12 +171,56 @@ def test_an_impossible_fit_is_rejected_with_its_reason(effect, gain_context, los
 
 
 def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
-    glazing = CANDIDATES["window_solar_gains"](gain_context)
-    dark = assess(glazing, _window(glazing, 0.12) | {"g_window_air": 0.0})
-    assert "area-weighted implied g-value: 0.02 is below any glazing (≥ 0.1)" in dark.problems
     ground = CANDIDATES["ground_coupling"](gain_context)
     hot = assess(ground, _ground(ground, 0.5, ground.detail["indoor_mean_c"] + 5.0))
     assert [p for p in hot.problems if p.startswith("mean ground temperature")], hot.problems
+
+
+def test_window_sun_beyond_the_declared_glazing_is_bounded_by_the_facade(gain_context):
+    """The west facade holds 6 m² of glazing in 36 m²: its sun may reach that of clear glass
+    over the whole facade, 0.87 × 36 / 6 = 5.2 times its declared glazing's."""
+    declared = with_declared_glazing(gain_context.network, SMALL, "int")
+    ctx = replace(gain_context, network=declared, params={**TRUTH_BASIC, "g_window": 0.5})
+    ext = CANDIDATES["window_solar_gains"](ctx)
+    assert ext.detail["orientations"]["270_90"]["facade_m2"] == pytest.approx(36.0)
+    fitted = {**ctx.params, "g_window_air": 0.0, "r_window": 0.5, **_window(ext, 0.0)}
+    west = assess(ext, {**fitted, "g_window_270_90": 4.0}).magnitudes["g_270_90"]["value"]
+    assert west == pytest.approx(4.5) and assess(ext, {**fitted, "g_window_270_90": 4.0}).plausible
+    too_much = assess(ext, {**fitted, "g_window_270_90": 5.0})
+    assert any(p.startswith("implied g-value of the west glazing") for p in too_much.problems)
+
+
+def test_glazing_a_description_leaves_out_is_looked_for_on_its_facades(gain_context):
+    """The south facade (40 m² of wall) declares no window: its sun may come in through glazing
+    the description leaves out, up to clear glass over the whole facade; the roof takes no part."""
+    ext = CANDIDATES["window_solar_gains"](gain_context)
+    south = ext.detail["orientations"]["180_90"]
+    assert south["area_m2"] == 0.0 and south["signal"] == "solar_opaque_180_90"
+    assert "g_window_0_0" not in ext.network.parameters
+    fitted = {**TRUTH_BASIC, **_window(ext, 0.0)}
+    assert assess(ext, {**fitted, "g_window_180_90": 0.5}).plausible
+    rejected = assess(ext, {**fitted, "g_window_180_90": 0.95})
+    assert rejected.problems == [
+        "share of the sun on the south facade let in by undeclared glazing: 0.95 exceeds any "
+        "facade glazed whole with clear glass (≤ 0.87)"
+    ]
+
+
+def test_the_base_model_is_given_the_declared_glazing():
+    """One g-value for all declared glazing, into the interior mass and the air, and the glazing's
+    conductance where the air has no path outdoors; nothing where none is declared."""
+    basic = get_model("basic", SMALL)
+    net = with_declared_glazing(basic, SMALL, "int")
+    assert {"g_window", "g_window_air", "r_window"} <= set(net.parameters)
+    assert {
+        (h.signal, h.node) for h in net.heat_inputs if h.gain in ("g_window", "g_window_air")
+    } == {
+        ("solar_window", "int"),
+        ("solar_window", "air"),
+    }
+    assert "g_window" not in basic.parameters  # the model as given is untouched
+    unglazed = Building.from_dict({**SMALL.to_dict(), "windows": []})
+    assert with_declared_glazing(basic, unglazed, "int") is basic
 
 
 def test_opaque_sun_enters_through_the_exterior_film(gain_context):

@@ -210,72 +210,87 @@ def _solar_by_orientation(
     )
 
 
+def _areas_by_orientation(surfaces: list) -> dict[str, float]:
+    areas: dict[str, float] = {}
+    for s in surfaces:
+        key = orientation_key(s.azimuth, s.tilt)
+        areas[key] = areas.get(key, 0.0) + s.area
+    return areas
+
+
+def facade_areas(building: Building) -> dict[str, float]:
+    """Gross area of each orientation's surfaces, glazing and opaque: the most glazing an
+    orientation could have. [m²]"""
+    glazed, opaque = (_areas_by_orientation(s) for s in (building.windows, building.walls))
+    return {k: glazed.get(k, 0.0) + opaque.get(k, 0.0) for k in {*glazed, *opaque}}
+
+
+def _facade_tilt(key: str) -> float:
+    return float(key.split("_")[1])
+
+
 def window_solar_gains(ctx: Context) -> Extension | Skipped:
-    """Solar heat through the glazing: g-value × the irradiance transmitted to each orientation's
-    glazing (× area, incidence-angle modifier included), absorbed by the interior mass, plus one
-    share g_air of all of it heating the air directly (sun on furniture and light linings); the
-    implied g-value of an orientation is g_k + g_air."""
+    """Solar heat through glazing beyond what the declared windows admit at one g-value, per
+    orientation, absorbed by the interior mass:
+
+    - where windows are declared, an extra g-value g_k × the irradiance transmitted to them
+      (``solar_window_<k>``: declared area × transmitted irradiance, incidence-angle modifier
+      included), the implied g-value being the declared glazing's plus g_k;
+    - on a facade with no declared window, the share s_k of the irradiance on its opaque
+      surfaces (``solar_opaque_<k>``: area × plane-of-array irradiance) that glazing the
+      description leaves out lets in, s_k = g × glazed share.
+
+    The base model carries the declared glazing (``declared``); no orientation may admit more
+    than clear glass over its whole facade (``plausibility``). Roofs take part only through
+    declared roof windows: an undeclared skylight's sun cannot be told from the roof's own
+    sol-air heat in a lumped model.
+    """
     effect = "window_solar_gains"
-    if not ctx.building.windows:
-        return Skipped(effect, "no windows in the building JSON")
-    if _has_signal(ctx.network, SOLAR_WINDOW):
-        return Skipped(effect, "the model already has window solar gains")
-    ext = _solar_by_orientation(
-        ctx,
+    if _has_signal(ctx.network, f"{SOLAR_WINDOW}_"):
+        return Skipped(effect, "the model already has window solar gains by orientation")
+    glazed = _areas_by_orientation(ctx.building.windows)
+    opaque = _areas_by_orientation(ctx.building.walls)
+    undeclared = [k for k in opaque if k not in glazed and _facade_tilt(k) >= 30]
+    if not glazed and not undeclared:
+        return Skipped(effect, "no windows or facades ('windows', 'walls') in the building JSON")
+    facades = facade_areas(ctx.building)
+    target = mass_node(ctx.network)
+    net = ctx.network.copy(_name(ctx.network, effect))
+    orientations, inputs = {}, []
+    for key in [*glazed, *undeclared]:
+        azimuth, tilt = (float(v) for v in key.split("_"))
+        facade, declared = _facade(azimuth, tilt), glazed.get(key, 0.0)
+        if declared:
+            signal, upper = SOLAR_WINDOW, facades[key] / declared
+            meaning = (
+                f"g-value the {facade} glazing ({declared:g} m²) adds to the declared glazing's"
+            )
+        else:
+            signal, upper = SOLAR_OPAQUE, 1.0
+            meaning = (
+                f"share of the sun on the {facade} facade ({facades[key]:g} m², no window "
+                "declared) let in by glazing the description leaves out: g × glazed share"
+            )
+        name = f"g_window_{key}"
+        net.add_parameter(Parameter(name, "-", 0.0, SEARCH_MARGIN * G_VALUE[1] * upper, meaning))
+        net.add_heat_input(solar_orientation_signal(signal, key), target, name)
+        inputs.append((solar_orientation_signal(signal, key), target))
+        orientations[key] = {
+            "area_m2": declared,
+            "facade": facade,
+            "facade_m2": facades[key],
+            "signal": solar_orientation_signal(signal, key),
+            "signal_area_m2": declared or facades[key],
+        }
+    params = tuple(f"g_window_{k}" for k in orientations)
+    return Extension(
         effect,
-        "window",
-        mass_node(ctx.network),
-        SEARCH_MARGIN * G_VALUE[1],
-        lambda facade, area: (
-            f"g-value of the {facade} glazing ({area:g} m²): share of the transmitted "
-            "irradiance heating the interior mass"
-        ),
-    )
-    ext = _window_air_share(ctx, ext)
-    if T_OUT in ctx.network.neighbours(ctx.network.output):
-        return ext
-    # Glazing is also a massless conductance between the air and outdoors; a model whose only
-    # path outdoors runs through the wall capacity cannot take the windows in without it.
-    glazing = sum(w.area for w in ctx.building.windows)
-    ext.network.add_parameter(
-        Parameter(
-            "r_window",
-            "m²K/W",
-            0.1,
-            100.0,
-            f"thermal resistance of the glazing ({glazing:g} m²), surface films included",
-        )
-    )
-    ext.network.add_resistor(T_OUT, ctx.network.output, "r_window", factor=1.0 / glazing)
-    return replace(
-        ext,
-        new_parameters=(*ext.new_parameters, "r_window"),
-        neutral={**ext.neutral, "r_window": 100.0},
-        detail={**ext.detail, "glazing_area_m2": glazing},
-    )
-
-
-def _window_air_share(ctx: Context, ext: Extension) -> Extension:
-    """``ext`` with g_air × (all the transmitted irradiance) into the air node, where the interior
-    mass is another node."""
-    air = ctx.network.output
-    if ext.detail["node"] == air:
-        return ext
-    ext.network.add_parameter(
-        Parameter(
-            "g_window_air",
-            "-",
-            0.0,
-            SEARCH_MARGIN * G_VALUE[1],
-            "part of the g-value heating the indoor air directly, every orientation",
-        )
-    )
-    ext.network.add_heat_input(SOLAR_WINDOW, air, "g_window_air")
-    return replace(
-        ext,
-        new_parameters=(*ext.new_parameters, "g_window_air"),
-        inputs=(*ext.inputs, (SOLAR_WINDOW, air)),
-        neutral={**ext.neutral, "g_window_air": 0.0},
+        net,
+        ctx.signals,
+        params,
+        tuple(inputs),
+        neutral=dict.fromkeys(params, 0.0),
+        detail={"orientations": orientations, "node": target},
     )
 
 
@@ -401,9 +416,7 @@ def _learnt_schedule(
     Learnt on both clocks a building may keep (civil time or standard time all year) unless the
     model already plays a schedule on one; the clock whose schedule explains more is kept.
     """
-    learnt = [
-        _schedule_on_clock(ctx, saturated, node, per_unit, clock) for clock in _clocks(ctx)
-    ]
+    learnt = [_schedule_on_clock(ctx, saturated, node, per_unit, clock) for clock in _clocks(ctx)]
     return max(learnt, key=lambda s: s.explained)
 
 

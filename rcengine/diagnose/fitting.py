@@ -22,6 +22,9 @@ from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.parallel import process_pool
 from rcengine.signals import SignalOptions, prepare
 
+# A fold's refit stays within this factor of the fit on the training half (``trust_region``). [-]
+TRUST_FACTOR = 3.0
+
 
 @dataclass(frozen=True)
 class Split:
@@ -122,13 +125,15 @@ def fit_model(
     preset: str | EstimatorSettings,
     random_state: int,
     warm_start: list[dict[str, float]] | None = None,
+    bounds: dict[str, tuple[float, float]] | None = None,
 ) -> Fit:
-    """Calibrate on ``split.train``; simulate both periods (initial states from each period's
-    first measurements) and filter them for innovations."""
+    """Calibrate on ``split.train`` (within ``bounds``, default the network's); simulate both
+    periods (initial states from each period's first measurements) and filter them for
+    innovations."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         est = Estimator(
-            network, preset=preset, random_state=random_state, warm_start=warm_start
+            network, preset=preset, random_state=random_state, warm_start=warm_start, bounds=bounds
         ).fit(split.train)
     compiled = est.compiled
     test_traj = Objective(compiled, split.test).trajectory(est.params_)
@@ -168,11 +173,40 @@ class FitJob:
     preset: str | EstimatorSettings
     random_state: int
     warm_start: list[dict[str, float]] | None = None
+    bounds: dict[str, tuple[float, float]] | None = None
 
     def run(self) -> Fit:
         return fit_model(
-            self.network, self.options, self.split, self.preset, self.random_state, self.warm_start
+            self.network,
+            self.options,
+            self.split,
+            self.preset,
+            self.random_state,
+            self.warm_start,
+            self.bounds,
         )
+
+
+def trust_region(
+    network: RCNetwork, params: dict[str, float], factor: float = TRUST_FACTOR
+) -> dict[str, tuple[float, float]]:
+    """Bounds within ``factor`` of ``params`` (a ratio for positive parameters, ``1/factor`` of
+    the range either side for the others), inside the network's own.
+
+    A few weeks of data identify a grey-box model's parameters poorly: refitted freely, a fold's
+    capacities and resistances drift to values that extrapolate its two test weeks by kelvins,
+    and one such fold decides the pooled test whatever the candidate does. Near the fit on the
+    whole training half, a fold adapts the model to its weeks without leaving that fit's basin.
+    """
+    out = {}
+    for name, p in network.parameters.items():
+        value = min(max(params[name], p.lower), p.upper)
+        if p.lower > 0:
+            out[name] = (max(p.lower, value / factor), min(p.upper, value * factor))
+        else:
+            half = (p.upper - p.lower) / factor
+            out[name] = (max(p.lower, value - half), min(p.upper, value + half))
+    return out
 
 
 def fit_many(jobs: list[FitJob], workers: int) -> list[Fit]:

@@ -178,9 +178,7 @@ def _bound_findings(
             (m[at_upper] for prefix, m in _BOUND_MEANING.items() if name.startswith(prefix)),
             "outside what this building's description allows",
         )
-        reasons.append(
-            f"{name} ended on its {side} bound {bound:.3g} {parameter.unit}: {meaning}"
-        )
+        reasons.append(f"{name} ended on its {side} bound {bound:.3g} {parameter.unit}: {meaning}")
     return on_bounds, reasons, notes
 
 

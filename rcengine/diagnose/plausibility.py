@@ -20,12 +20,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from rcengine.columns import Q_HVAC, SOLAR_OPAQUE, solar_orientation_signal
+from rcengine.columns import Q_HVAC, SOLAR_OPAQUE, SOLAR_WINDOW, solar_orientation_signal
 from rcengine.models.bounds import (
     ABSORPTANCE_MAX,
     G_GLAZING_MAX,
     KAPPA_INTERNAL,
-    U_GLAZING,
     U_GROUND_MAX,
     opaque_solar_share_max,
 )
@@ -156,19 +155,36 @@ def _by_orientation(
     return [*readings, Reading(f"{name}_mean", mean, "-", f"area-weighted {quantity}", full, of)]
 
 
+def _declared_g(ext: Extension, params: Mapping[str, float]) -> float:
+    """The declared glazing's g-value in the fitted model: its steady aperture (the share of the
+    transmitted sun reaching the air), else the sum of its gains when ``params`` is partial."""
+    if set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals:
+        return solar_apertures(ext.network, dict(params)).get(SOLAR_WINDOW, 0.0)
+    return sum(
+        h.factor * (params.get(h.gain, 0.0) if isinstance(h.gain, str) else h.gain)
+        for h in ext.network.heat_inputs
+        if h.signal == SOLAR_WINDOW
+    )
+
+
 def _window(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Implied g-value per orientation, g_k (to the mass) + g_air (to the air), each at most that
-    of clear glass; their area-weighted mean at least that of shaded solar-control glazing."""
-    air = params.get("g_window_air", 0.0)
-    g = {k: params[f"g_window_{k}"] + air for k in ext.detail["orientations"]}
-    readings = _by_orientation(ext, g, "g", ("implied g-value", "glazing"), G_VALUE)
-    if "g_window_air" in params:
-        readings.append(Reading("g_air", air, "-", "part of the g-value heating the air directly"))
-    if "r_window" in params:
-        u = 1.0 / params["r_window"]
+    """Per orientation with declared glazing, its implied g-value (the declared glazing's plus
+    the orientation's extra), at most that of clear glass filling the whole facade (G_max ×
+    facade / declared glazing); per facade with none declared, the share of its sun let in, at
+    most G_max (the facade glazed whole): the most sun an orientation's surfaces can let in."""
+    declared = _declared_g(ext, params)
+    readings = [Reading("g_declared", declared, "-", "g-value of the declared glazing")]
+    for k, o in ext.detail["orientations"].items():
+        extra = params[f"g_window_{k}"]
+        if o["area_m2"]:
+            value, most = declared + extra, G_VALUE[1] * o["facade_m2"] / o["area_m2"]
+            meaning = f"implied g-value of the {o['facade']} glazing ({o['area_m2']:g} m² declared)"
+        else:
+            value, most = extra, G_VALUE[1]
+            meaning = f"share of the sun on the {o['facade']} facade let in by undeclared glazing"
         readings.append(
             Reading(
-                "u_glazing", u, "W/(m²K)", "U-value of the glazing", (0.0, U_GLAZING[1]), "glazing"
+                f"g_{k}", value, "-", meaning, (0.0, most), "facade glazed whole with clear glass"
             )
         )
     return readings

@@ -284,9 +284,9 @@ def _across(finding: Finding) -> str:
 
 
 def verdict(findings: list[Finding], health: Health | None) -> str:
-    """"nothing missing", "missing: <effect>[, <effect>]", or, when the base model cannot
-    represent the building, "base model inadequate: <reasons>" and what was found against the
-    healthy model reached by a repair step, or against the inadequate one when none was."""
+    """The verdict: "nothing missing", "missing: <effect>[, <effect>]", or, when the base model
+    cannot represent the building, "base model inadequate: <reasons>" and what was found against
+    the healthy model reached by a repair step, or against the inadequate one when none was."""
     missing = [f.effect for f in findings if f.accepted and not f.baseline_repair]
     found = "missing: " + ", ".join(missing) if missing else "nothing missing"
     if health is None or health.healthy:
@@ -317,24 +317,27 @@ def _facts(finding: Finding) -> str:
     d = finding.detail
     if "orientations" in d:
         peaks = d.get("peak_input", {})
-        faces = ", ".join(
-            f"{v['facade']} {v['area_m2']:g} m²"
-            + (
-                f" receiving up to {peaks[s] / v['area_m2']:.0f} W/m²"
-                if (s := _signal_of(finding, k)) in peaks
-                else ""
-            )
-            for k, v in d["orientations"].items()
-        )
+        faces = ", ".join(_face(finding, k, v, peaks) for k, v in d["orientations"].items())
         return f" ({faces})"
     if "schedule" in d:
         return f" (schedule learnt from the residuals: {d['schedule']})"
     return ""
 
 
-def _signal_of(finding: Finding, orientation: str) -> str:
+def _face(finding: Finding, key: str, orientation: dict, peaks: dict[str, float]) -> str:
+    """One orientation's surfaces in words, with the highest irradiance they received."""
+    area, facade = orientation["area_m2"], orientation["facade"]
+    words = (
+        f"{facade} {area:g} m²"
+        if area
+        else f"{facade} facade of {orientation['facade_m2']:g} m² with no window declared"
+    )
     total = SOLAR_WINDOW if finding.effect == "window_solar_gains" else SOLAR_OPAQUE
-    return solar_orientation_signal(total, orientation)
+    signal = orientation.get("signal", solar_orientation_signal(total, key))
+    if signal not in peaks:
+        return words
+    per_m2 = peaks[signal] / orientation.get("signal_area_m2", area)
+    return f"{words}, receiving up to {per_m2:.0f} W/m²"
 
 
 @dataclass
@@ -389,6 +392,9 @@ class Report:
                 "rmse_train": self.final.rmse_train,
                 "rmse_test": self.final.rmse_test,
                 "parameters": self.final.params,
+                # What rebuilds the final model exactly (rcengine.models.spec.ModelSpec).
+                "network": self.final.network.to_dict(),
+                "signals": self.final.options.to_dict(),
             },
             "verdict": verdict(self.findings, self.health),
             "evidence": {

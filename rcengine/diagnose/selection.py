@@ -27,7 +27,8 @@ import pandas as pd
 
 from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
-from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped
+from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
+from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -36,6 +37,7 @@ from rcengine.diagnose.fitting import (
     fold_splits,
     residual_at,
     split_data,
+    trust_region,
 )
 from rcengine.diagnose.folds import Fold, FoldEvidence, head_to_head, rolling_folds
 from rcengine.diagnose.health import FitQuality, Health, check_health, fit_quality
@@ -204,7 +206,7 @@ def _baseline(problem: Problem, model: str) -> Fit:
     within the building's bounds started from its optimum competes with the others.
     """
     settings, options = problem.settings, SignalOptions()
-    network = get_model(model, problem.building, problem.frame.columns, bounds=settings.bounds)
+    network = _base_model(problem, model, settings.bounds)
     split = problem.split(network, options)
     starts = [
         FitJob(network, options, split, settings.preset, settings.random_state + k)
@@ -212,7 +214,7 @@ def _baseline(problem: Problem, model: str) -> Fit:
     ]
     widened = settings.bounds != "thesis"
     if widened:
-        typical = get_model(model, problem.building, problem.frame.columns, bounds="thesis")
+        typical = _base_model(problem, model, "thesis")
         typical_split = problem.split(typical, options)
         starts[-1] = FitJob(typical, options, typical_split, settings.preset, settings.random_state)
     fits = fit_many(starts, settings.workers)
@@ -222,6 +224,12 @@ def _baseline(problem: Problem, model: str) -> Fit:
             network, options, split, settings.preset, settings.random_state, [fits[-1].params]
         ).run()
     return min(fits, key=lambda f: f.sse_train)
+
+
+def _base_model(problem: Problem, model: str, bounds: str) -> RCNetwork:
+    """The model as given, with the glazing the building declares (``declared``)."""
+    network = get_model(model, problem.building, problem.frame.columns, bounds=bounds)
+    return with_declared_glazing(network, problem.building, mass_node(network))
 
 
 def _health(problem: Problem, fit: Fit) -> tuple[FitQuality, Health]:
@@ -417,6 +425,7 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     screens = {
         e.effect: screen(e, current, splits[e.effect], settings.random_state) for e in extensions
     }
+
     # Screening is a linearisation; the first round refits every candidate for real, later
     # rounds the ones whose earlier refit helped most.
     def promise(e: Extension) -> tuple[float, float]:
@@ -455,11 +464,17 @@ def _confirm_on_folds(
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
     if state.current_folds is None:
         models.insert(0, (state.current.network, state.current.options, state.current.params))
-    problem.say(
-        f"  confirming {', '.join(e.effect for e, _ in passing)} on {n} rolling folds"
-    )
+    problem.say(f"  confirming {', '.join(e.effect for e, _ in passing)} on {n} rolling folds")
     jobs = [
-        FitJob(network, options, split, settings.fold_preset, settings.random_state, [params])
+        FitJob(
+            network,
+            options,
+            split,
+            settings.fold_preset,
+            settings.random_state,
+            [params],
+            trust_region(network, params),
+        )
         for network, options, params in models
         for split in fold_splits(problem.frame, problem.building, network, options, problem.folds)
     ]

@@ -28,7 +28,7 @@ from rcengine.columns import (
 )
 from rcengine.dataset import Dataset
 from rcengine.exceptions import ModelError
-from rcengine.signals.ground import seasonal_ground_temperature
+from rcengine.signals.ground import AnnualCycle, seasonal_ground_temperature
 from rcengine.signals.schedules import Zone, clock_zone, schedule_signal
 from rcengine.signals.solar import solar_gains, solar_signal_names
 
@@ -45,7 +45,9 @@ class SignalOptions:
     or None to neglect reflection; iam_model: glazing incidence-angle modifier; decomposition:
     ghi → dni/dhi model when those columns are absent; schedules: weekly 0/1 or level profiles
     (168 hourly values) by name; schedule_clock: "local" (civil time, daylight saving) or
-    "standard" (standard time all year) for playing them back.
+    "standard" (standard time all year) for playing them back; ground_cycle: the outdoor annual
+    cycle under ``t_ground`` (``AnnualCycle.to_dict``), fixed once fitted, else fitted to the
+    frame at hand (``signals.ground``).
     """
 
     sky_model: str = "isotropic"
@@ -54,6 +56,7 @@ class SignalOptions:
     decomposition: str = "erbs"
     schedules: dict[str, list[float]] = field(default_factory=dict)
     schedule_clock: str = "local"
+    ground_cycle: dict[str, float | str] | None = None
 
     def schedule_zone(self, building: Building) -> Zone:
         return clock_zone(building.location.timezone, self.schedule_clock)
@@ -117,9 +120,10 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
     fitted on top, through a constant heat input on ``unit``); unit = 1 [-]."""
     t_out = frame[T_OUT].to_numpy(dtype=float)
     latitude = building.location.latitude
+    cycle = None if options.ground_cycle is None else AnnualCycle.from_dict(options.ground_cycle)
     return pd.DataFrame(
         {
-            T_GROUND: seasonal_ground_temperature(frame.index, t_out, latitude),
+            T_GROUND: seasonal_ground_temperature(frame.index, t_out, latitude, cycle=cycle),
             UNIT: np.ones(len(frame)),
         },
         index=frame.index,

@@ -82,6 +82,13 @@ class AnnualCycle:
         """2π(t − coldest)/year at ``times``. [rad]"""
         return 2.0 * np.pi * (times - self.coldest).total_seconds().to_numpy() / YEAR_S
 
+    def to_dict(self) -> dict[str, float | str]:
+        return {"mean": self.mean, "amplitude": self.amplitude, "coldest": self.coldest.isoformat()}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> AnnualCycle:
+        return cls(float(data["mean"]), float(data["amplitude"]), pd.Timestamp(data["coldest"]))
+
 
 def annual_cycle(times: pd.DatetimeIndex, t_out: np.ndarray, latitude: float) -> AnnualCycle:
     """Least-squares mean and amplitude of the annual cycle through ``t_out`` [°C] at ``times``,
@@ -112,12 +119,15 @@ def seasonal_ground_temperature(
     t_out: np.ndarray,
     latitude: float,
     depth_m: float = GROUND_DEPTH_M,
+    cycle: AnnualCycle | None = None,
 ) -> np.ndarray:
     """The outdoor annual cycle damped and lagged ``depth_m`` into the soil. [°C]
 
     T_g(t) = T_m − A·e^(−z/δ)·cos(2π(t − t_cold)/year − z/δ), z = ``depth_m``, δ =
-    ``SOIL_PENETRATION_DEPTH_M``, T_m, A and t_cold from ``annual_cycle``.
+    ``SOIL_PENETRATION_DEPTH_M``, T_m, A and t_cold from ``annual_cycle`` — or ``cycle``, one
+    fitted once on a long record: a stored model must see the same ground temperature in a
+    one-day forecast as in the months it was fitted on.
     """
-    cycle = annual_cycle(times, t_out, latitude)
+    cycle = cycle if cycle is not None else annual_cycle(times, t_out, latitude)
     depth = depth_m / SOIL_PENETRATION_DEPTH_M
     return cycle.mean - cycle.amplitude * np.exp(-depth) * np.cos(cycle.phase(times) - depth)

@@ -171,8 +171,10 @@ def strength(data: pd.DataFrame, reference: pd.DataFrame | None) -> dict[str, fl
 
 
 def variant_building(case: shoebox.Case, site: SiteInfo) -> dict:
+    """Building JSON of a variant. A variant's window is its concealed glazing: the JSON lists the
+    facade it is in as opaque wall, since glazing the description declares is given to the base
+    model and is not what a diagnosis looks for."""
     box = case.building
-    window = box.window()
     return building_description(
         f"shoebox-{case.name}",
         site,
@@ -180,7 +182,7 @@ def variant_building(case: shoebox.Case, site: SiteInfo) -> dict:
         volume=shoebox.BOX.volume,
         wall_area=sum(w.area for w in box.walls()),
         internal_mass_area=box.internal_mass_area,
-        windows=[] if window is None else [window],
+        windows=[],
         walls=box.walls(),
         roof_area=shoebox.BOX.floor_area if box.exposed_roof else 0.0,
     )

@@ -490,10 +490,16 @@ def contract_rows(frame: pd.DataFrame, step: str = STEP) -> pd.DataFrame:
 
 
 def case_building(case: Case, site: SiteInfo) -> dict:
-    """Building JSON of the case (CONTRACT.md §2), facades at their turned azimuths."""
+    """Building JSON of the case (CONTRACT.md §2), facades at their turned azimuths.
+
+    The JSON declares the ordinary glazing share on every facade, large windows included: a
+    concealed window effect is glazing the description leaves out (an owner's drawings that
+    predate a refurbishment), never glazing it declares, which the base model is given.
+    """
     b = case.building()
     a = b.archetype
     walls = b.exterior_walls()
+    declared = replace(b, large_glazing=())
     return building_description(
         f"testbed-{case.name}",
         site,
@@ -501,7 +507,7 @@ def case_building(case: Case, site: SiteInfo) -> dict:
         volume=a.volume,
         wall_area=sum(w.area for w in walls),
         internal_mass_area=b.internal_mass_area,
-        windows=b.windows(),
+        windows=declared.windows(),
         walls=walls,
         roof_area=b.roof_area,
         timezone=CLIMATES[case.climate].calendar.timezone,
