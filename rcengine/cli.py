@@ -1,11 +1,12 @@
 """Command line (CONTRACT.md §3); ``rcengine COMMAND --help`` describes each option.
 
-- ``fit DATA -b BUILDING -m MODEL -o PARAMS [--start --end --preset --weekdays --seed
-  --sky-model]``: calibrate MODEL, write its parameter set;
+- ``fit DATA -b BUILDING (-m MODEL | --model-file SPEC) -o PARAMS [--start --end --preset
+  --weekdays --seed --sky-model]``: calibrate MODEL, write its parameter set;
 - ``predict DATA -p PARAMS --start START --hours H -o FORECAST``: forecast ``t_in``;
 - ``models [--json]``: the model library;
-- ``diagnose DATA -b BUILDING [-m MODEL --json REPORT --html REPORT --train-fraction --seed]``:
-  locate the model–data mismatch and name the missing physics;
+- ``diagnose DATA -b BUILDING [-m MODEL --json REPORT --html REPORT --train-fraction --seed
+  --save-model SPEC]``: locate the model–data mismatch, name the missing physics, save the
+  extended model for ``fit --model-file``;
 - ``study DATA -b BUILDING -o FOLDER [--freefloat --models --start --end --workers --preset
   --seed --criterion]``: the thesis's rolling learn/predict study.
 
@@ -35,6 +36,8 @@ from rcengine.forecast import forecast
 from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
+from rcengine.models.spec import ModelSpec, check_columns
+from rcengine.network import RCNetwork
 from rcengine.parameter_set import ParameterSet
 from rcengine.signals import SignalOptions, prepare
 
@@ -96,8 +99,14 @@ def _period(
 def fit(
     data: DataArg,
     building: BuildingOpt,
-    model: Annotated[str, typer.Option("--model", "-m", help="model name, see `rcengine models`")],
     output: Annotated[Path, typer.Option("-o", "--output", help="parameter file to write")],
+    model: Annotated[
+        str | None, typer.Option("--model", "-m", help="model name, see `rcengine models`")
+    ] = None,
+    model_file: Annotated[
+        Path | None,
+        typer.Option(help="model specification (`rcengine diagnose --save-model`) instead of -m"),
+    ] = None,
     start: Annotated[str | None, typer.Option(help=f"first time fitted: {WHEN}")] = None,
     end: Annotated[str | None, typer.Option(help=f"end of the fit (exclusive): {WHEN}")] = None,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "default",
@@ -108,28 +117,29 @@ def fit(
         str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
     ] = "output_error",
 ) -> None:
-    """Calibrate MODEL on DATA and write the parameter set as JSON."""
+    """Calibrate MODEL (or the model of --model-file) on DATA and write the parameter set."""
 
     _check(check_criterion, criterion)
+    if (model is None) == (model_file is None):
+        fail("give either --model or --model-file")
 
     def run() -> None:
         b = Building.from_json(building)
         first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
-        net = get_model(model, b, frame.columns)
-        options = SignalOptions(sky_model=sky_model)
+        name, net, options = _model_to_fit(model, model_file, b, frame, sky_model)
         dataset = prepare(frame, b, net.compile().input_names, options).between(first, last)
         if weekdays:
             dataset = dataset.weekdays(b.location.timezone)
         typer.echo(
-            f"fitting {model} on {len(dataset)} rows ({len(dataset.segments)} segment(s)), "
+            f"fitting {name} on {len(dataset)} rows ({len(dataset.segments)} segment(s)), "
             f"{dataset.times[0]} → {dataset.times[-1]}"
         )
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConvergenceWarning)
             est = Estimator(net, preset=preset, random_state=seed, criterion=criterion)
             est.fit(dataset)
-        params = ParameterSet.from_estimator(est, dataset, b, model, options)
+        params = ParameterSet.from_estimator(est, dataset, b, name, options)
         params.save(output)
         _print_fit(params, est)
         for w in caught:
@@ -137,6 +147,19 @@ def fit(
         typer.echo(f"wrote {output}")
 
     _run(run)
+
+
+def _model_to_fit(
+    model: str | None, model_file: Path | None, building: Building, frame: pd.DataFrame, sky: str
+) -> tuple[str, RCNetwork, SignalOptions]:
+    """The library model ``model``, or the stored specification ``model_file`` (its network and
+    signal settings, its sky model included)."""
+    if model_file is None:
+        assert model is not None
+        return model, get_model(model, building, frame.columns), SignalOptions(sky_model=sky)
+    spec = ModelSpec.load(model_file)
+    check_columns(spec, frame.columns)
+    return spec.name, spec.network(building), spec.signals
 
 
 def _print_fit(params: ParameterSet, est: Estimator) -> None:
@@ -225,6 +248,10 @@ def diagnose(
     html_out: Annotated[Path | None, typer.Option("--html", help="HTML report to write")] = None,
     train_fraction: Annotated[float, typer.Option(help="share of the record fitted")] = 0.5,
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    save_model: Annotated[
+        Path | None,
+        typer.Option(help="write the final model's specification (for `fit --model-file`)"),
+    ] = None,
 ) -> None:
     """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
     from rcengine.diagnose import DiagnoseSettings, selection
@@ -251,8 +278,26 @@ def diagnose(
         if html_out:
             html_out.write_text(render(report))
             typer.echo(f"wrote {html_out}")
+        if save_model:
+            _save_model(d, b, frame, model, save_model)
 
     _run(run)
+
+
+def _save_model(
+    report: dict, building: Building, frame: pd.DataFrame, model: str, path: Path
+) -> None:
+    """The diagnosed model as a specification; the base model (as the diagnosis bounded it)
+    when nothing was accepted, so that `fit --model-file` always has a model to fit."""
+    if any(f["accepted"] for f in report["findings"]):
+        spec = ModelSpec.from_report(report, building, frame)
+    else:
+        final = report["final"]
+        network = RCNetwork.from_dict(final["network"])
+        spec = ModelSpec.base(network, model, building, SignalOptions(**final["signals"]))
+    spec.save(path)
+    effects = ", ".join(spec.effects) or "none accepted"
+    typer.echo(f"wrote {path} (model {spec.name}; effects: {effects})")
 
 
 @app.command()

@@ -13,7 +13,9 @@ parameters mostly inside their bounds, better than persistence, plausible predic
 failed fit, a worse or a refused set never replaces the current one; each is stored with its
 reason (the job's ``details.gate`` names the checks that refused it).
 
-:func:`work` is what a calibration job runs (the job itself is handled by ``service.jobs``).
+:func:`work` is what a calibration job runs (the job itself is handled by ``service.jobs``):
+:func:`load` reads what it needs, :func:`compute` fits and decides without the database (so that a
+remote backend runs it where the data was sent).
 """
 
 from __future__ import annotations
@@ -35,8 +37,9 @@ from rcengine.exceptions import ConvergenceWarning, RCEngineError
 from rcengine.forecast import forecast
 from rcengine.metrics import FitMetrics, evaluate
 from rcengine.models import get_model
+from rcengine.models.spec import ModelSpec, check_columns
 from rcengine.parameter_set import ParameterSet
-from rcengine.signals import prepare
+from rcengine.signals import SignalOptions, prepare
 
 from . import bridge, promotion, repository
 from .core.db import Database
@@ -107,6 +110,7 @@ class Calibrated:
         fit = self.parameter_set.fit
         return {
             "parameter_set_id": record.id,
+            "model": self.parameter_set.model,
             "reason": self.reason,
             "window": self.window.to_dict(),
             "training_rows": fit["rows"],
@@ -122,11 +126,30 @@ class Calibrated:
         }
 
 
+@dataclass(frozen=True)
+class Inputs:
+    """What a fit needs from the database, read by the service (:func:`load`) so that
+    :func:`compute` can run anywhere, a Dask worker included, without a connection."""
+
+    building: Building
+    model: str
+    window: Window
+    frame: pd.DataFrame
+    current_set: ParameterSet | None
+    current_id: int | None
+    # The building's adopted model (service.adoption), fitted instead of ``model``.
+    spec: ModelSpec | None = None
+
+
 def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrated:
     """Fit on the job's days, score against the current set on the held-out day, decide."""
+    return compute(load(db, job, options), options)
+
+
+def load(db: Database, job: JobRecord, options: CalibrationOptions) -> Inputs:
+    """The job's building, window, stored rows and current set, in one read session."""
     with db.session() as session:
         building_row = repository.get_building(session, job.building_id)
-        building = bridge.building_of(building_row.description)
         window = _window(
             building_row.last_measured_at,
             building_row.step_s,
@@ -135,16 +158,29 @@ def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrate
         )
         frame = bridge.load_frame(session, job.building_id, window.train_start, window.end)
         current = repository.current_parameter_set(session, job.building_id)
-        current_set = None if current is None else bridge.parameter_set_of(current)
+        return Inputs(
+            bridge.building_of(building_row.description),
+            job.model,
+            window,
+            frame,
+            None if current is None else bridge.parameter_set_of(current),
+            None if current is None else current.id,
+            _adopted(building_row.model_spec),
+        )
+
+
+def compute(inputs: Inputs, options: CalibrationOptions) -> Calibrated:
+    """The fit, both held-out scores and the gate on :func:`load`'s inputs (no database)."""
+    frame, window = inputs.frame, inputs.window
     training = frame.loc[frame.index < window.holdout_start]
     _check_enough(training, window)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConvergenceWarning)
-        fitted = fit_parameter_set(training, building, job.model, options)
+        fitted = fit_parameter_set(training, inputs.building, inputs.model, options, inputs.spec)
     holdout, predicted = holdout_forecast(fitted, frame, window)
     new_score = evaluate(holdout[T_IN].to_numpy(dtype=float), predicted)
     fitted = replace(fitted, metrics={**fitted.metrics, "holdout": new_score.to_dict()})
-    current_score, note = _score_current(current_set, frame, window)
+    current_score, note = _score_current(inputs.current_set, frame, window)
     gate = promotion.judge(fitted, training, holdout, predicted)
     better = current_score is None or new_score.rmse <= current_score.rmse
     return Calibrated(
@@ -152,7 +188,7 @@ def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrate
         window,
         new_score,
         current_score,
-        None if current is None else current.id,
+        inputs.current_id,
         better and gate.passed,
         gate.reason() if not gate.passed else note or _verdict(new_score, current_score),
         [str(w.message) for w in caught],
@@ -161,11 +197,20 @@ def work(db: Database, job: JobRecord, options: CalibrationOptions) -> Calibrate
 
 
 def fit_parameter_set(
-    training: pd.DataFrame, building: Building, model: str, options: CalibrationOptions
+    training: pd.DataFrame,
+    building: Building,
+    model: str,
+    options: CalibrationOptions,
+    spec: ModelSpec | None = None,
 ) -> ParameterSet:
-    """The engine's GA + GPS fit of ``model`` on the training rows."""
-    network = get_model(model, building, training.columns)
-    data = prepare(training, building, network.compile().input_names)
+    """The engine's GA + GPS fit of ``model``, or of the adopted model ``spec`` (its network
+    and derived-signal settings), on the training rows."""
+    if spec is None:
+        network, signals = get_model(model, building, training.columns), SignalOptions()
+    else:
+        check_columns(spec, training.columns)
+        network, signals, model = spec.network(building), spec.signals, spec.name
+    data = prepare(training, building, network.compile().input_names, signals)
     estimator = Estimator(
         network,
         preset=options.preset,
@@ -173,7 +218,7 @@ def fit_parameter_set(
         criterion=options.criterion,
     )
     estimator.fit(data)
-    return ParameterSet.from_estimator(estimator, data, building, model)
+    return ParameterSet.from_estimator(estimator, data, building, model, signals)
 
 
 def holdout_forecast(
@@ -214,6 +259,10 @@ def _window(
     end = pd.Timestamp(last_measured) + pd.Timedelta(seconds=step_s)
     holdout_start = end - pd.Timedelta(hours=holdout_h)
     return Window(holdout_start - pd.Timedelta(days=days), holdout_start, end, step_s)
+
+
+def _adopted(document: dict[str, Any] | None) -> ModelSpec | None:
+    return None if document is None else ModelSpec.from_dict(document)
 
 
 def _check_enough(training: pd.DataFrame, window: Window) -> None:

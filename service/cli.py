@@ -56,26 +56,37 @@ def serve(
 
 
 @app.command("retrain-all")
-def retrain_all() -> None:
-    """Calibrate every building with new data since its last job, once (for an external cron).
-
-    Exits with 1 if any job failed.
+def retrain_all(
+    dask: Annotated[
+        str | None,
+        typer.Option(
+            help="run the fits on Dask: a scheduler address (tcp://host:8786) or 'local' "
+            "(default: RCSERVICE_DASK_SCHEDULER, else the process pool of RCSERVICE_WORKERS)",
+        ),
+    ] = None,
+    progress: Annotated[bool, typer.Option(help="show a progress bar")] = True,
+) -> None:
+    """Calibrate every building with new data since its last job, once (for an external cron,
+    or beside running replicas: they share the queue). Prints a summary; exits with 1 if any
+    job failed.
     """
+    import json
+
+    from .backends import make_backend
     from .core.db import Database
-    from .jobs import retrain_all_inline
-    from .models import FAILED
+    from .fleet import retrain_all as run_pass
 
     settings = _settings()
     db = Database(settings.database_url)
     try:
         db.migrate()
-        results = retrain_all_inline(db, settings, trigger="cli")
+        summary = run_pass(settings, db, make_backend(settings, dask), progress=progress)
     finally:
         db.dispose()
-    for job_id, status in results.items():
-        typer.echo(f"job {job_id}: {status}")
-    typer.echo(f"{len(results)} job(s) run")
-    if FAILED in results.values():
+    for line in summary.lines():
+        typer.echo(line)
+    typer.echo(json.dumps(summary.to_dict()))
+    if summary.failed:
         raise typer.Exit(code=1)
 
 

@@ -159,26 +159,51 @@ class Diagnosed:
         }
 
 
+@dataclass(frozen=True)
+class Inputs:
+    """What a diagnosis needs from the database, read by the service (:func:`load`), so that
+    :func:`compute` can run anywhere, a Dask worker included, without a connection."""
+
+    building_id: int
+    job_id: int
+    model: str
+    plan: DiagnosisPlan
+    building: Building
+    step_s: float
+    frame: pd.DataFrame
+
+
 def work(db: Database, job: JobRecord, options: DiagnosisOptions) -> Diagnosed:
     """Diagnose the window planned for the job on the stored rows."""
+    return compute(load(db, job, options), options)
+
+
+def load(db: Database, job: JobRecord, options: DiagnosisOptions) -> Inputs:
+    """The job's building and the stored rows of its planned window."""
     job_plan = DiagnosisPlan.from_dict(job.options)
     with db.session() as session:
         row = repository.get_building(session, job.building_id)
         building, step_s = bridge.building_of(row.description), row.step_s
         frame = bridge.load_frame(session, job.building_id, job_plan.start, job_plan.end)
+    return Inputs(job.building_id, job.id, job.model, job_plan, building, step_s, frame)
+
+
+def compute(inputs: Inputs, options: DiagnosisOptions) -> Diagnosed:
+    """The engine's diagnosis on :func:`load`'s inputs (no database)."""
+    job_plan, frame, step_s = inputs.plan, inputs.frame, inputs.step_s
     _check_enough(frame, job_plan, step_s)
     settings = engine_settings(job_plan, options)
-    context = {"job_id": job.id, "building_id": job.building_id}
+    context = {"job_id": inputs.job_id, "building_id": inputs.building_id}
     report, page = diagnose_frame(
         frame,
-        building,
-        job.model,
+        inputs.building,
+        inputs.model,
         settings,
         lambda step: log.info("diagnosis progress", extra={**context, "step": step}),
     )
     record = DiagnosisRecord(
-        building_id=job.building_id,
-        model=job.model,
+        building_id=inputs.building_id,
+        model=inputs.model,
         window_start=bridge.to_datetime(frame.index[0]),
         window_end=bridge.to_datetime(frame.index[-1] + pd.Timedelta(seconds=step_s)),
         settings={

@@ -27,6 +27,7 @@ from rcengine.forecast import (
 )
 from rcengine.io.timeseries import format_times
 from rcengine.kalman import Noise
+from rcengine.models.spec import check_future_columns
 from rcengine.network import CompiledNetwork
 from rcengine.parameter_set import ParameterSet
 from rcengine.statespace import DiscreteStateSpace
@@ -99,7 +100,8 @@ class Prediction:
 
 @dataclass(frozen=True)
 class ModelState:
-    """The discrete model of the current set and the filtered state at ``at``."""
+    """The discrete model of the current set, the filtered state at ``at`` and the rows it was
+    loaded with (those after ``at`` too, when asked for)."""
 
     parameter_set: SetInfo
     timezone: str
@@ -107,6 +109,17 @@ class ModelState:
     at: pd.Timestamp
     state: np.ndarray
     covariance: np.ndarray
+    data: Dataset
+
+    def inputs_from_state(self, steps: int, decided: str) -> tuple[pd.DatetimeIndex, np.ndarray]:
+        """Stored inputs (steps, m) from ``at`` in the model's order, with the ``decided``
+        input (an MPC's decision, which need not be stored) set to zero."""
+        names = self.model.input_names
+        known = tuple(n for n in names if n != decided)
+        times, values = future_inputs(self.data, self.at, steps, known)
+        u = np.zeros((steps, len(names)))
+        u[:, [names.index(n) for n in known]] = values
+        return times, u
 
 
 class ForecastKey(NamedTuple):
@@ -167,16 +180,22 @@ class Forecaster:
         outputs = trajectories(prediction.model, prediction.state0, prediction.inputs(), q_hvac)
         return prediction, outputs
 
-    def model_state(self, building_id: int, at: pd.Timestamp | None) -> ModelState:
+    def model_state(
+        self, building_id: int, at: pd.Timestamp | None, hours: float = 0.0
+    ) -> ModelState:
         """Discrete (A, B, C, D) of the current set and the Kalman state at ``at`` (default:
-        one step after the last measured ``t_in``) from the measurements before it."""
+        one step after the last measured ``t_in``) from the measurements before it; the rows
+        of the ``hours`` after ``at`` come along for a plan."""
         with self.db.session() as session:
             key = repository.forecast_key(session, building_id)
             if key.set_id is None:
                 raise NoParameterSetError(building_id)
             at = at if at is not None else _after_last_measured(key)
             frame = bridge.load_frame(
-                session, building_id, at - pd.Timedelta(hours=self.history_h), at
+                session,
+                building_id,
+                at - pd.Timedelta(hours=self.history_h),
+                at + pd.Timedelta(hours=hours),
             )
         loaded = self._loaded(building_id, key.set_id)
         _require_rows(frame, at - pd.Timedelta(hours=self.history_h), at)
@@ -187,7 +206,7 @@ class Forecaster:
         )
         filtered = initial_state(model, data, at, self.history_h)
         return ModelState(
-            loaded.info, key.timezone, model, at, filtered.state, filtered.covariance
+            loaded.info, key.timezone, model, at, filtered.state, filtered.covariance, data
         )
 
     def _predict(
@@ -199,6 +218,8 @@ class Forecaster:
             frame = bridge.load_frame(session, building_id, first, end)
         loaded = self._loaded(building_id, set_id)
         _require_rows(frame, first, end)
+        # Named by the columns to upload, not by the derived inputs computed from them.
+        check_future_columns(frame, loaded.compiled.input_names, start, end)
         data = loaded.pset.prepare(frame)
         result = forecast(
             loaded.compiled, loaded.pset.values, data, start, hours, self.history_h, loaded.noise

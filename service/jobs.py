@@ -12,6 +12,12 @@ A run holds its job by a lease (owner, fencing token, heartbeat, expiry; see
 ``repository.start_job``): a heartbeat thread renews it, and the run's final write must still
 hold it, or nothing of the run is stored. Jobs whose lease expired (their process died with its
 server) are failed at start-up and by a reaper thread, which moves the token on.
+
+Several service processes can share one PostgreSQL database: a process runs a queued job only
+by claiming it (``repository.claim_next_job``, ``FOR UPDATE SKIP LOCKED``, or ``start_job`` for a
+named job — whoever marks it running first runs it), so the nightly batch queued by every
+replica's scheduler is spread over them and each building is fitted once. Where the work runs
+(the process pool or Dask) is the backend's choice (``service.backends``).
 """
 
 from __future__ import annotations
@@ -28,12 +34,14 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from sqlalchemy import select
 from sqlalchemy.exc import SQLAlchemyError
 from sqlalchemy.orm import Session
 
 from rcengine.exceptions import RCEngineError
 
-from . import calibration, diagnosis, repository
+from . import adoption, calibration, diagnosis, repository
+from .backends import Backend, make_backend
 from .calibration import CalibrationOptions
 from .core.config import Settings
 from .core.db import Database
@@ -43,14 +51,17 @@ from .models import (
     CALIBRATION,
     DIAGNOSIS,
     FAILED,
+    RUNNING,
     SUCCEEDED,
     BuildingRecord,
     JobRecord,
+    utc_now,
 )
-from .pool import make_executor, warm_up
 
 log = logging.getLogger(__name__)
 INTERRUPTED = "interrupted: the server stopped before the job finished"
+# Triggers of the nightly re-estimation (scheduler, retrain-all): re-run when interrupted.
+NIGHTLY_TRIGGERS = ("schedule", "cli")
 
 
 class Product(Protocol):
@@ -85,15 +96,6 @@ def kinds(settings: Settings) -> dict[str, tuple[Work, Any]]:
     }
 
 
-def run_job(database_url: str, job_id: int, work: Work, options: Any, terms: LeaseTerms) -> None:
-    """Worker entry: its own database engine, then :func:`execute`."""
-    db = Database(database_url)
-    try:
-        execute(db, job_id, work, options, terms)
-    finally:
-        db.dispose()
-
-
 @dataclass(frozen=True)
 class LeaseTerms:
     """Who runs a job (a server process) and for how long a lease lasts unrenewed. [s]"""
@@ -109,9 +111,54 @@ def execute(
     failed work; LeaseLostError when the lease was taken over (nothing of this run is stored).
     """
     terms = terms or LeaseTerms()
-    started = time.perf_counter()
     with db.write() as session:
         lease = repository.start_job(session, job_id, terms.owner, terms.seconds)
+    return run_leased(db, lease, work, options, terms)
+
+
+def execute_next(
+    db: Database,
+    kind: str,
+    work: Work,
+    options: Any,
+    terms: LeaseTerms,
+    building_ids: tuple[int, ...] = (),
+) -> tuple[int, str] | None:
+    """Claim the oldest queued job of ``kind`` and run it; (job id, final status), or None when
+    the queue is empty (other processes may be claiming from it at the same time)."""
+    with db.write() as session:
+        lease = repository.claim_next_job(session, kind, terms.owner, terms.seconds, building_ids)
+    if lease is None:
+        return None
+    try:
+        return lease.job_id, run_leased(db, lease, work, options, terms)
+    except LeaseLostError as exc:  # the job was failed when its lease expired
+        log.warning("job run fenced off", extra={"job_id": lease.job_id, "error": str(exc)})
+        return lease.job_id, FAILED
+
+
+def drain(
+    db: Database,
+    kind: str,
+    work: Work,
+    options: Any,
+    terms: LeaseTerms,
+    building_ids: tuple[int, ...] = (),
+) -> dict[int, str]:
+    """Claim and run queued jobs of ``kind`` until none is left; {job id: final status}."""
+    done: dict[int, str] = {}
+    while (ran := execute_next(db, kind, work, options, terms, building_ids)) is not None:
+        done[ran[0]] = ran[1]
+    return done
+
+
+def run_leased(
+    db: Database, lease: repository.Lease, work: Work, options: Any, terms: LeaseTerms
+) -> str:
+    """Run the job ``lease`` holds (see :func:`execute`)."""
+    started = time.perf_counter()
+    job_id = lease.job_id
+    with db.session() as session:
         job = repository.get_job(session, job_id)
     context = {"job_id": job_id, "building_id": job.building_id, "lease": str(lease)}
     log.info("%s started", job.kind, extra=context)
@@ -179,13 +226,15 @@ def describe(exc: BaseException) -> str:
 
 
 class JobRunner:
-    """Owns the executor; ``create_calibration`` and ``create_diagnosis`` queue a job and hand
-    it over at once. One executor runs every kind."""
+    """Owns the backend and its executor; ``create_calibration`` and ``create_diagnosis`` queue
+    a job and hand it over at once, ``drain`` runs what is queued. One executor runs every
+    kind."""
 
-    def __init__(self, settings: Settings, db: Database):
+    def __init__(self, settings: Settings, db: Database, backend: Backend | None = None):
         self.settings = settings
         self.db = db
         self.terms = LeaseTerms(seconds=settings.job_lease_s)
+        self.backend = backend or make_backend(settings)
         self._kinds = kinds(settings)
         self._lock = threading.Lock()
         self._dispatcher = Dispatcher()
@@ -235,30 +284,63 @@ class JobRunner:
         handed = self._dispatcher.submit(self._hand_over, job_id, kind)
         handed.add_done_callback(lambda f: self._finished(job_id, f))
 
+    def drain(self, kind: str, building_ids: tuple[int, ...] = ()) -> list[Future]:
+        """Claim and run the queued jobs of ``kind`` (of ``building_ids`` if given) on every
+        slot of the backend until none is left; futures of each slot's {job id: status}."""
+        return [
+            self._dispatcher.submit(self._hand_over_drain, kind, building_ids).result()
+            for _ in range(self.backend.slots())
+        ]
+
+    def resume_queued(self) -> None:
+        """Claim and run what is queued, of every kind (at start-up on a shared database: jobs
+        queued by a replica that died before running them)."""
+        for kind in self._kinds:
+            self.drain(kind)
+
     def _hand_over(self, job_id: int, kind: str) -> None:
         work, options = self._kinds[kind]
-        arguments = (run_job, self.db.url, job_id, work, options, self.terms)
+        future = self._submit(execute, job_id, work, options, self.terms)
+        future.add_done_callback(lambda f: self._finished(job_id, f))
+        if kind == DIAGNOSIS and self.settings.auto_adopt:
+            future.add_done_callback(lambda f: adoption.after_diagnosis(self, job_id, f))
+
+    def _hand_over_drain(self, kind: str, building_ids: tuple[int, ...]) -> Future:
+        work, options = self._kinds[kind]
+        future = self._submit(drain, kind, work, options, self.terms, building_ids)
+        future.add_done_callback(self._drained)
+        return future
+
+    def _submit(self, entry: Callable[..., Any], first: Any, work: Work, *rest: Any) -> Future:
         try:
-            future = self._executor.submit(*arguments)
+            return self._executor.submit(*self._call(entry, first, work, *rest))
         except BrokenProcessPool:  # a worker died (killed, out of memory): start a new pool
             with self._lock:
                 self._executor = self._new_executor()
-            future = self._executor.submit(*arguments)
-        future.add_done_callback(lambda f: self._finished(job_id, f))
+            return self._executor.submit(*self._call(entry, first, work, *rest))
+
+    def _call(self, entry: Callable[..., Any], first: Any, work: Work, *rest: Any) -> tuple:
+        fn, arguments = self.backend.call(self.db, entry, first, work, *rest)
+        return (fn, *arguments)
 
     def shutdown(self) -> None:
         """Cancel jobs not yet started (marked failed); let running ones finish."""
         self._stop.set()
         self._dispatcher.cancel_pending()
         self._executor.shutdown(wait=False, cancel_futures=True)
+        self.backend.close()
 
     def _reap(self) -> None:
         """Fail running jobs whose lease expired (their process died) while the server runs."""
         while not self._stop.wait(max(self.terms.seconds / 2.0, 0.5)):
             try:
-                fail_abandoned(self.db)
+                failed = fail_abandoned(self.db)
+                again = requeue_interrupted(self.db, self.settings, failed) if failed else []
             except SQLAlchemyError as exc:  # the database is away: try again at the next round
                 log.warning("abandoned jobs not reaped", extra={"error": str(exc)})
+                continue
+            if again:  # nightly jobs of a dead process: run here, once each
+                self.drain(CALIBRATION, tuple(again))
 
     def _finished(self, job_id: int, future: Future) -> None:
         # The worker records every failure itself; this catches a worker that died or could
@@ -269,6 +351,9 @@ class JobRunner:
         if isinstance(exc, LeaseLostError):  # the job was failed when its lease expired
             log.warning("job run fenced off", extra={"job_id": job_id, "error": str(exc)})
             return
+        if isinstance(exc, ConflictError):  # another process claimed it first and runs it
+            log.info("job claimed elsewhere", extra={"job_id": job_id, "error": str(exc)})
+            return
         reason = INTERRUPTED if future.cancelled() else f"worker error: {describe(exc)}"
         try:
             with self.db.write() as session:
@@ -277,11 +362,14 @@ class JobRunner:
             return
         log.error("job ended abnormally", extra={"job_id": job_id, "error": reason})
 
+    def _drained(self, future: Future) -> None:
+        # A drain records each job's failure itself; a slot lost whole (its worker process
+        # died) leaves its current job to the reaper, once the lease expires.
+        if not future.cancelled() and future.exception() is not None:
+            log.error("job slot ended abnormally", extra={"error": describe(future.exception())})
+
     def _new_executor(self) -> Executor:
-        executor = make_executor(self.settings.workers, self.settings.log_level)
-        if self.settings.workers > 0:
-            executor.submit(warm_up)
-        return executor
+        return self.backend.new_executor()
 
 
 class Dispatcher:
@@ -346,8 +434,35 @@ def _measured_building(session: Session, building_id: int) -> BuildingRecord:
 
 def fail_interrupted(db: Database) -> list[int]:
     """At start-up: jobs left queued by a previous server process, and running ones whose lease
-    expired, failed (running ones still leased are failed by the reaper once it expires)."""
-    return fail_abandoned(db, queued_too=True)
+    expired, failed (running ones still leased are failed by the reaper once it expires). On a
+    database several processes share (PostgreSQL), queued jobs may be another live replica's:
+    they stay queued for whichever process claims them."""
+    return fail_abandoned(db, queued_too=db.engine.dialect.name == "sqlite")
+
+
+def announce_mode(settings: Settings, db: Database, owner: str) -> None:
+    """At start-up: SQLite runs one service process; say so, loudly when another process seems
+    to share the file (a live lease of another owner, or several uvicorn workers asked for)."""
+    if settings.several_processes:
+        log.info("jobs are claimed from a queue replicas share", extra={"owner": owner})
+        return
+    with db.session() as session:
+        others = session.scalars(
+            select(JobRecord.lease_owner).where(
+                JobRecord.status == RUNNING,
+                JobRecord.lease_expires_at > utc_now(),
+                JobRecord.lease_owner != owner,
+            )
+        ).all()
+    workers = os.environ.get("WEB_CONCURRENCY", "1")
+    if others or workers not in ("", "1"):
+        log.warning(
+            "SQLite runs one service process: several replicas (or uvicorn workers) need "
+            "PostgreSQL (RCSERVICE_DATABASE_URL=postgresql+psycopg://...; docs/fleet.md)",
+            extra={"other_lease_owners": sorted(set(others)), "web_concurrency": workers},
+        )
+    else:
+        log.info("SQLite: single-process mode (several replicas need PostgreSQL)")
 
 
 def fail_abandoned(db: Database, queued_too: bool = False) -> list[int]:
@@ -359,16 +474,23 @@ def fail_abandoned(db: Database, queued_too: bool = False) -> list[int]:
     return ids
 
 
-def queue_retraining(db: Database, settings: Settings, trigger: str) -> list[int]:
-    """A queued calibration for every building with new data since its last one; returns their
-    ids. Buildings that already have an active calibration are skipped.
+def queue_retraining(
+    db: Database, settings: Settings, trigger: str, among: tuple[int, ...] = ()
+) -> list[int]:
+    """A queued calibration for every building (``among`` these if given) with new data since
+    its last one; returns their ids. Buildings that already have an active calibration are
+    skipped, and so are those another process fitted meanwhile: each building is re-checked
+    with its row locked, so replicas queueing at the same time queue it once.
     """
     with db.session() as session:
-        building_ids = repository.buildings_with_new_data(session)
+        building_ids = repository.buildings_with_new_data(session, INTERRUPTED, among)
     queued = []
     for building_id in building_ids:
         try:
             with db.write() as session:
+                repository.lock_building(session, building_id)
+                if not repository.buildings_with_new_data(session, INTERRUPTED, (building_id,)):
+                    continue
                 job = add_calibration(
                     session, building_id, trigger, settings.model, settings.training_days
                 )
@@ -378,10 +500,14 @@ def queue_retraining(db: Database, settings: Settings, trigger: str) -> list[int
     return queued
 
 
-def retrain_all_inline(db: Database, settings: Settings, trigger: str) -> dict[int, str]:
-    """``rcservice retrain-all``: queue and run every due calibration here, one after another."""
-    work, options = kinds(settings)[CALIBRATION]
-    return {
-        job_id: execute(db, job_id, work, options, LeaseTerms(seconds=settings.job_lease_s))
-        for job_id in queue_retraining(db, settings, trigger)
-    }
+def requeue_interrupted(db: Database, settings: Settings, job_ids: list[int]) -> list[int]:
+    """The buildings of nightly calibrations among ``job_ids`` (failed: their process died)
+    queued again, once; returns the buildings queued."""
+    with db.session() as session:
+        jobs = [repository.get_job(session, job_id) for job_id in job_ids]
+    again = []
+    for job in jobs:
+        nightly = job.kind == CALIBRATION and job.trigger in NIGHTLY_TRIGGERS
+        if nightly and queue_retraining(db, settings, job.trigger, (job.building_id,)):
+            again.append(job.building_id)
+    return again

@@ -18,9 +18,10 @@ from .context import ServiceContext
 from .core.config import Settings
 from .core.db import Database
 from .forecasting import Forecaster
-from .jobs import JobRunner, fail_interrupted
+from .jobs import JobRunner, announce_mode, fail_interrupted
 from .scheduler import start_scheduler
 from .tokens import TokenIndex, admin_token_hash
+from .ui import install_ui
 
 log = logging.getLogger(__name__)
 
@@ -35,7 +36,9 @@ Calibrated grey-box RC thermal models of buildings for Model Predictive Control.
    building with new data.
 4. `GET /buildings/{id}/forecast`, `POST /buildings/{id}/simulate`, `GET /buildings/{id}/model`.
 5. `POST /buildings/{id}/diagnoses`, then `GET /buildings/{id}/diagnosis` (JSON or HTML): where
-   the model misses the measurements and which physics it lacks.
+   the model misses the measurements and which physics it lacks; `POST
+   /buildings/{id}/diagnoses/{diagnosis_id}/adopt` makes that model the building's (calibrated at
+   once, served only if it wins the held-out day), `POST /buildings/{id}/model/revert` undoes it.
 
 Every call but `/health` needs `Authorization: Bearer <token>`.
 """
@@ -68,6 +71,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(RequestLogMiddleware)
     install_error_handlers(app)
     app.include_router(api_router)
+    install_ui(app)
     return app
 
 
@@ -81,6 +85,9 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     admin_hash = admin_token_hash(settings, db)
     fail_interrupted(db)
     runner = JobRunner(settings, db)
+    announce_mode(settings, db, runner.terms.owner)
+    if settings.several_processes:  # jobs a dead replica queued are claimed, not failed
+        runner.resume_queued()
     scheduler = start_scheduler(settings, db, runner) if settings.scheduler_enabled else None
     app.state.context = ServiceContext(
         settings=settings,

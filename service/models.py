@@ -93,6 +93,9 @@ class BuildingRecord(Base):
     # Incremented by every upload; forecasts are cached per revision, jobs record the one fitted.
     data_revision: Mapped[int] = mapped_column(Integer, default=0)
     created_at: Mapped[datetime] = mapped_column(default=utc_now)
+    # The adopted model (rcengine.models.spec.ModelSpec document) every calibration fits; None:
+    # the base model of the service's settings or of the calibration request.
+    model_spec: Mapped[dict[str, Any] | None] = mapped_column(JSON)
 
 
 measurements = Table(
@@ -213,6 +216,31 @@ class DiagnosisRecord(JobProduct, Base):
     html: Mapped[str] = mapped_column(Text, deferred=True)
 
     __table_args__ = (Index("ix_diagnoses_building_created", "building_id", "created_at"),)
+
+
+class ModelChangeRecord(Base):
+    """One adopt or revert call (audit): who made it (admin, building token or the automatic
+    adoption), when, which diagnosis, the model in use after it, whether it changed anything,
+    and the calibration it started."""
+
+    __tablename__ = "model_changes"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
+    action: Mapped[str] = mapped_column(String(16))
+    diagnosis_id: Mapped[int | None] = mapped_column(
+        ForeignKey("diagnoses.id", ondelete="SET NULL")
+    )
+    model: Mapped[str | None] = mapped_column(String(200))
+    actor: Mapped[str] = mapped_column(String(32))
+    changed: Mapped[bool] = mapped_column(default=False)
+    calibration_job_id: Mapped[int | None] = mapped_column(
+        ForeignKey("jobs.id", ondelete="SET NULL")
+    )
+    detail: Mapped[dict[str, Any] | None] = mapped_column(JSON)
+    created_at: Mapped[datetime] = mapped_column(default=utc_now)
+
+    __table_args__ = (Index("ix_model_changes_building", "building_id", "id"),)
 
 
 class AdminTokenRecord(Base):

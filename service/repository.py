@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta
 from typing import Any
 
-from sqlalchemy import Connection, Insert, Row, Select, and_, func, select, update
+from sqlalchemy import Connection, Insert, Row, Select, String, and_, cast, func, select, update
 from sqlalchemy.dialects import postgresql, sqlite
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
@@ -199,6 +199,20 @@ def read_measurements(
     return session.execute(query.order_by(time)).all()
 
 
+def read_series(
+    session: Session, building_id: int, columns: Sequence[str], start: datetime
+) -> Sequence[Row]:
+    """(time as text, *columns) rows of a building from ``start`` on, in time order: a long
+    series for display, whose times ``pandas.to_datetime(..., utc=True)`` parses at once (the
+    per-row datetime conversion of :func:`read_measurements` costs ~20 µs a row). The text is
+    UTC on SQLite (stored naive) and carries its offset on PostgreSQL."""
+    time = measurements.c[TIME]
+    query = select(cast(time, String), *(measurements.c[c] for c in columns)).where(
+        measurements.c.building_id == building_id, time >= start
+    )
+    return session.execute(query.order_by(time)).all()
+
+
 # --- jobs -------------------------------------------------------------------------------------
 def add_job(
     session: Session,
@@ -287,6 +301,20 @@ def start_job(session: Session, job_id: int, owner: str = "", lease_s: float = 0
     return Lease(job_id, owner, token)
 
 
+def claim_next_job(
+    session: Session, kind: str, owner: str, lease_s: float, building_ids: Sequence[int] = ()
+) -> Lease | None:
+    """Start the oldest queued job of ``kind`` (of ``building_ids`` if given) under a lease of
+    ``owner``; None when none is left. Several processes claim from one queue: PostgreSQL skips
+    the rows another transaction is claiming (``FOR UPDATE SKIP LOCKED``) instead of waiting for
+    them; SQLite's write transaction holds the database's write lock already."""
+    query = select(JobRecord.id).where(JobRecord.status == QUEUED, JobRecord.kind == kind)
+    if building_ids:
+        query = query.where(JobRecord.building_id.in_(building_ids))
+    job_id = session.scalar(query.order_by(JobRecord.id).limit(1).with_for_update(skip_locked=True))
+    return None if job_id is None else start_job(session, job_id, owner, lease_s)
+
+
 def renew_lease(session: Session, lease: Lease, lease_s: float) -> bool:
     """Heartbeat: extend the lease by ``lease_s`` from now; False if it was taken over."""
     now = utc_now()
@@ -364,14 +392,19 @@ def fail_abandoned_jobs(session: Session, reason: str, queued_too: bool = False)
     return sorted(ids)
 
 
-def buildings_with_new_data(session: Session) -> list[int]:
-    """Buildings whose data changed since their last calibration job (or that never had one)."""
-    last_job = (
-        select(JobRecord.building_id, func.max(JobRecord.data_revision).label("revision"))
-        .where(JobRecord.kind == CALIBRATION)
-        .group_by(JobRecord.building_id)
-        .subquery()
-    )
+def buildings_with_new_data(
+    session: Session, unless_error: str | None = None, among: Sequence[int] = ()
+) -> list[int]:
+    """Buildings (``among`` these if given) whose data changed since their last calibration job
+    (or that never had one); a job that failed with ``unless_error`` (interrupted: its process
+    died) does not count."""
+    fitted = select(JobRecord.building_id, func.max(JobRecord.data_revision).label("revision"))
+    fitted = fitted.where(JobRecord.kind == CALIBRATION)
+    if among:
+        fitted = fitted.where(JobRecord.building_id.in_(among))
+    if unless_error is not None:
+        fitted = fitted.where((JobRecord.error.is_(None)) | (JobRecord.error != unless_error))
+    last_job = fitted.group_by(JobRecord.building_id).subquery()
     query = (
         select(BuildingRecord.id)
         .outerjoin(last_job, last_job.c.building_id == BuildingRecord.id)
@@ -381,6 +414,8 @@ def buildings_with_new_data(session: Session) -> list[int]:
         )
         .order_by(BuildingRecord.id)
     )
+    if among:
+        query = query.where(BuildingRecord.id.in_(among))
     return list(session.scalars(query))
 
 

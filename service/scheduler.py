@@ -1,4 +1,5 @@
-"""Nightly re-estimation: an APScheduler cron job at ``retrain_hour`` in ``timezone``."""
+"""Nightly re-estimation: an APScheduler cron job at ``retrain_hour`` in ``timezone``, run by every
+replica of the service (they share the queue; see ``service.jobs``)."""
 
 from __future__ import annotations
 
@@ -37,8 +38,11 @@ def start_scheduler(settings: Settings, db: Database, runner: JobRunner) -> Back
 
 
 def retrain_due(settings: Settings, db: Database, runner: JobRunner) -> list[int]:
+    """Queue what is due and claim queued calibrations on every slot of this process.
+
+    Safe in every replica: a building is queued once (re-checked under its row lock) and a job
+    is run by the one process that claims it, so replicas share the night's work."""
     job_ids = queue_retraining(db, settings, trigger="schedule")
-    for job_id in job_ids:
-        runner.submit(job_id, CALIBRATION)
+    runner.drain(CALIBRATION)
     log.info("nightly retraining queued", extra={"job_ids": job_ids})
     return job_ids

@@ -4,6 +4,7 @@ HTTP status codes)."""
 from fastapi import APIRouter
 
 from .routes import (
+    adoption,
     buildings,
     calibrations,
     diagnoses,
@@ -12,10 +13,22 @@ from .routes import (
     jobs,
     measurements,
     parameters,
+    plan,
 )
 
 # In the order of the OpenAPI page.
-ROUTES = (health, buildings, measurements, calibrations, diagnoses, jobs, parameters, forecast)
+ROUTES = (
+    health,
+    buildings,
+    measurements,
+    calibrations,
+    diagnoses,
+    adoption,
+    jobs,
+    parameters,
+    forecast,
+    plan,
+)
 
 api_router = APIRouter()
 for module in ROUTES:

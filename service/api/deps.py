@@ -59,25 +59,6 @@ async def require_admin(ctx: ContextDep, credentials: Credentials) -> None:
     raise _unauthorized("invalid token")
 
 
-async def building_access(
-    building_id: Annotated[int, id_in_path("Building", 1)],
-    ctx: ContextDep,
-    credentials: Credentials,
-) -> int:
-    """The path's building id, if the token may reach it."""
-    token_hash = _token_hash(credentials)
-    if _is_admin(ctx, token_hash):
-        with ctx.db.session() as session:
-            repository.get_building(session, building_id)  # NotFoundError: 404
-        return building_id
-    owner = ctx.tokens.building_for(token_hash)
-    if owner is None:
-        raise _unauthorized("invalid token")
-    if owner != building_id:
-        raise HTTPException(status.HTTP_404_NOT_FOUND, f"building {building_id} not found")
-    return building_id
-
-
 async def token_building(ctx: ContextDep, credentials: Credentials) -> int | None:
     """The building a token belongs to; None for the admin token."""
     token_hash = _token_hash(credentials)
@@ -87,6 +68,21 @@ async def token_building(ctx: ContextDep, credentials: Credentials) -> int | Non
     if owner is None:
         raise _unauthorized("invalid token")
     return owner
+
+
+async def building_access(
+    building_id: Annotated[int, id_in_path("Building", 1)],
+    ctx: ContextDep,
+    credentials: Credentials,
+) -> int:
+    """The path's building id, if the token may reach it."""
+    owner = await token_building(ctx, credentials)
+    if owner is None:  # the admin token: any building that exists
+        with ctx.db.session() as session:
+            repository.get_building(session, building_id)  # NotFoundError: 404
+    elif owner != building_id:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"building {building_id} not found")
+    return building_id
 
 
 AdminDep = Annotated[None, Depends(require_admin)]

@@ -65,6 +65,12 @@ class Settings(BaseSettings):
         description="Estimator preset of every fit of a diagnosis (default: the engine's, "
         "study).",
     )
+    auto_adopt: bool = Field(
+        False,
+        description="Adopt a diagnosis's model as soon as it accepts findings (as POST "
+        "/buildings/{id}/diagnoses/{diagnosis_id}/adopt does, audited as 'auto'): its first "
+        "calibration runs at once and is served only if it wins the held-out day.",
+    )
     max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="Request size limit.")
     workers: int = Field(
         1,
@@ -72,6 +78,12 @@ class Settings(BaseSettings):
         le=64,
         description="Worker processes for jobs (calibrations, diagnoses); 0 runs them on a "
         "thread of the server process (tests, tiny deployments).",
+    )
+    dask_scheduler: str | None = Field(
+        None,
+        description="Run jobs on Dask distributed instead of the worker processes: the "
+        "scheduler's address (tcp://host:8786), or 'local' for a LocalCluster sized to this "
+        "machine. Unset: the in-process pool (docs/fleet.md).",
     )
     forecast_cache_size: int = Field(512, ge=0, description="Forecasts kept in memory.")
     job_lease_s: float = Field(
@@ -121,6 +133,17 @@ class Settings(BaseSettings):
             )
         return value
 
+    @field_validator("dask_scheduler")
+    @classmethod
+    def _dask_address(cls, value: str | None) -> str | None:
+        if value in (None, "", "local"):
+            return value or None
+        if "://" not in value:
+            raise ValueError(
+                f"invalid Dask scheduler {value!r}: give its address (tcp://host:8786) or 'local'"
+            )
+        return value
+
     @field_validator("database_url")
     @classmethod
     def _parsable_url(cls, value: str) -> str:
@@ -134,6 +157,12 @@ class Settings(BaseSettings):
         if url.get_backend_name() != "sqlite" or url.database in (None, "", ":memory:"):
             return None
         return Path(url.database)
+
+    @property
+    def several_processes(self) -> bool:
+        """Whether several service processes may share the database (PostgreSQL), claiming
+        jobs from one queue; SQLite runs one process."""
+        return make_url(self.database_url).get_backend_name() != "sqlite"
 
     def token_file(self) -> Path:
         if self.admin_token_file is not None:

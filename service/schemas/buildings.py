@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, Field
 
+from .adoption import ModelInUse
 from .common import LocalTime, with_examples
 
 EXAMPLE = {
@@ -110,6 +111,11 @@ class BuildingRead(BaseModel):
     last_measured_time: LocalTime | None = Field(description="Latest row with a measured t_in")
     data_revision: int = Field(description="Incremented by every upload")
     current_parameter_set_id: int | None
+    model: ModelInUse | None = Field(
+        None,
+        description="The model calibrations fit and where it came from (adopted from a "
+        "diagnosis, or the base model); in GET /buildings/{id}, not in the list",
+    )
 
 
 class BuildingList(BaseModel):

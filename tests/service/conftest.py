@@ -9,24 +9,27 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 import httpx
 import numpy as np
 import pandas as pd
 import pytest
+from alembic.config import Config
 from fastapi.testclient import TestClient
+from sqlalchemy import text
 
 from rcengine.io.timeseries import format_times
 from service.core.config import Settings
-from service.core.db import Database
+from service.core.db import Database, alembic_config
 from service.main import create_app
 
 from ..synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
@@ -36,7 +39,8 @@ ADMIN_TOKEN = "test-admin-token-0123456789abcdef"
 ADMIN = {"Authorization": f"Bearer {ADMIN_TOKEN}"}
 TIMEZONE = "Europe/Rome"
 SYNTHETIC_BUILDING = {**BUILDING.to_dict(), "name": "synthetic-office"}
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "energyplus" / "office"
+ROOT = Path(__file__).resolve().parents[2]
+OFFICE = ROOT / "data" / "energyplus" / "office"
 
 
 def bearer(token: str) -> dict[str, str]:
@@ -93,15 +97,46 @@ def database_url(backend: str, tmp_path: Path, request: pytest.FixtureRequest) -
 
 
 # --- in-process app -------------------------------------------------------------------------
-@pytest.fixture
-def settings(database_url: str) -> Settings:
+def app_settings(database_url: str, **overrides: Any) -> Settings:
+    """Settings of an in-process test app: the test admin token, jobs on a thread (so that a
+    test can monkeypatch them), no scheduler; ``overrides`` for the rest."""
     return Settings(
         database_url=database_url,
         admin_token=ADMIN_TOKEN,
         workers=0,
         scheduler_enabled=False,
-        max_body_bytes=200_000,
+        **overrides,
     )
+
+
+def module_client(
+    tmp_path_factory: pytest.TempPathFactory, name: str, **overrides: Any
+) -> Iterator[TestClient]:
+    """The body of a module-scoped ``client`` fixture: one app on a SQLite file in a fresh
+    folder ``name``, shared by the module's tests (``yield from module_client(...)``)."""
+    folder = tmp_path_factory.mktemp(name)
+    settings = app_settings(f"sqlite:///{folder / 'rcservice.db'}", **overrides)
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+@pytest.fixture
+def settings(database_url: str) -> Settings:
+    return app_settings(database_url, max_body_bytes=200_000)
+
+
+def migrate(db: Database, step: Callable[[Config, str], None], revision: str) -> None:
+    """``step`` (alembic upgrade or downgrade) on the service's own connection (foreign keys on)."""
+    with db.engine.begin() as connection:
+        config = alembic_config(db.url)
+        config.attributes["connection"] = connection
+        step(config, revision)
+
+
+def schema_revision(db: Database) -> str:
+    """The migration the database is at."""
+    with db.session() as session:
+        return session.execute(text("SELECT version_num FROM alembic_version")).scalar()
 
 
 @pytest.fixture
@@ -170,6 +205,15 @@ def measured(client, three_days_measured) -> tuple[int, dict]:
         headers=headers,
     )
     assert response.status_code == 200, response.text
+    return building_id, headers
+
+
+@pytest.fixture
+def calibrated(client, measured) -> tuple[int, dict]:
+    """Days 1–3 measured, day 4 future inputs only, a current set fitted on day 2."""
+    building_id, headers = measured
+    job = client.post(f"/buildings/{building_id}/calibrations", json={"days": 1}, headers=headers)
+    assert wait_for_job(client, job.json()["id"], headers)["outcome"] == "promoted"
     return building_id, headers
 
 
@@ -255,6 +299,35 @@ def live_server(tmp_path: Path) -> Iterator[LiveServer]:
         yield server.start()
     finally:
         server.stop()
+
+
+def run_docs_session(
+    folder: Path, heading: str, **env: str
+) -> tuple[subprocess.CompletedProcess[str], str]:
+    """Run the first bash block after ``heading`` in docs/service.md as written, against a live
+    server in ``folder`` with the repository's data beside it; the run and the server's log.
+
+    No admin token is given: the server generates one into rcservice-admin-token beside its
+    database, as for `make run`, and the session reads it from there."""
+    docs = (ROOT / "docs" / "service.md").read_text()
+    after = docs[docs.index(heading) :]
+    block = re.search(r"```bash\n(.*?)```", after, re.DOTALL).group(1)
+    (folder / "data").symlink_to(ROOT / "data")
+    server = LiveServer(folder, **env)
+    server.env.pop("RCSERVICE_ADMIN_TOKEN")
+    server.start()
+    try:
+        run = subprocess.run(
+            ["bash", "-c", "set -euo pipefail\n" + block.replace("localhost:8000", server.url)],
+            cwd=folder,
+            capture_output=True,
+            text=True,
+            timeout=600,
+            env={**os.environ, "PATH": f"{Path(sys.executable).parent}:{os.environ['PATH']}"},
+        )
+    finally:
+        server.stop()
+    return run, server.log()
 
 
 def rmse(a, b) -> float:

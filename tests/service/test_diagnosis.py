@@ -23,11 +23,18 @@ from sqlalchemy import inspect, text
 
 from rcengine.io.timeseries import format_times, read_timeseries
 from service import diagnosis
-from service.core.config import Settings
-from service.core.db import Database, alembic_config
-from service.main import create_app
+from service.core.db import Database
 
-from .conftest import ADMIN, ADMIN_TOKEN, bearer, json_rows, register, wait_for_job
+from .conftest import (
+    ADMIN,
+    bearer,
+    json_rows,
+    migrate,
+    module_client,
+    register,
+    schema_revision,
+    wait_for_job,
+)
 
 DAYS = 14
 STEP = pd.Timedelta(minutes=15)
@@ -46,18 +53,13 @@ def variant(project_data: Path) -> tuple[dict, pd.DataFrame]:
 @pytest.fixture(scope="module")
 def client(tmp_path_factory) -> Iterator[TestClient]:
     """One app for the module; diagnoses with the fast "modestpy" preset and 14 days."""
-    folder = tmp_path_factory.mktemp("diagnosis")
-    settings = Settings(
-        database_url=f"sqlite:///{folder / 'rcservice.db'}",
-        admin_token=ADMIN_TOKEN,
-        workers=0,
-        scheduler_enabled=False,
+    yield from module_client(
+        tmp_path_factory,
+        "diagnosis",
         preset="modestpy",
         diagnosis_preset="modestpy",
         diagnosis_days=DAYS,
     )
-    with TestClient(create_app(settings)) as test_client:
-        yield test_client
 
 
 def measured_building(client: TestClient, variant) -> tuple[int, dict]:
@@ -312,28 +314,19 @@ def test_one_active_diagnosis_per_building_and_a_calibration_beside_it(
 
 
 # --- the migration ----------------------------------------------------------------------------
-def _migrate(db: Database, step, revision: str) -> None:
-    """``step`` (alembic upgrade or downgrade) on the service's own connection (foreign keys on)."""
-    with db.engine.begin() as connection:
-        config = alembic_config(db.url)
-        config.attributes["connection"] = connection
-        step(config, revision)
-
-
 def test_migration_applies_on_a_fresh_sqlite_file(tmp_path):
     db = Database(f"sqlite:///{tmp_path / 'fresh.db'}")
     db.migrate()
     tables = inspect(db.engine)
     assert "diagnoses" in tables.get_table_names()
     assert {"kind", "options"} <= {c["name"] for c in tables.get_columns("jobs")}
-    with db.session() as session:
-        assert session.execute(text("SELECT version_num FROM alembic_version")).scalar() == "0003"
+    assert schema_revision(db) == "0004"
     db.dispose()
 
 
 def test_migration_keeps_existing_jobs_as_calibrations_and_downgrades(tmp_path):
     db = Database(f"sqlite:///{tmp_path / 'old.db'}")
-    _migrate(db, command.upgrade, "0001")
+    migrate(db, command.upgrade, "0001")
     now = "2017-01-30 00:00:00"
     with db.engine.begin() as connection:
         connection.execute(
@@ -358,10 +351,10 @@ def test_migration_keeps_existing_jobs_as_calibrations_and_downgrades(tmp_path):
             ),
             {"now": now},
         )
-    _migrate(db, command.upgrade, "head")
+    migrate(db, command.upgrade, "head")
     with db.session() as session:
         assert session.execute(text("SELECT kind FROM jobs")).scalars().all() == ["calibration"]
-    _migrate(db, command.downgrade, "0001")
+    migrate(db, command.downgrade, "0001")
     tables = inspect(db.engine)
     assert "diagnoses" not in tables.get_table_names()
     assert "kind" not in {c["name"] for c in tables.get_columns("jobs")}

@@ -17,15 +17,6 @@ from .conftest import DAY, json_rows, register, rmse, wait_for_job
 ON_BOTH_DATABASES = True
 
 
-@pytest.fixture
-def calibrated(client, measured):
-    """Days 1–3 measured, day 4 future inputs only, a current set fitted on day 2."""
-    building_id, headers = measured
-    job = client.post(f"/buildings/{building_id}/calibrations", json={"days": 1}, headers=headers)
-    assert wait_for_job(client, job.json()["id"], headers)["outcome"] == "promoted"
-    return building_id, headers
-
-
 def get_forecast(client, building_id, headers, **params):
     return client.get(f"/buildings/{building_id}/forecast", params=params, headers=headers)
 

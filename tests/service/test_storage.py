@@ -150,7 +150,7 @@ def test_retrain_all_command_calibrates_due_buildings_once(
     runner = CliRunner()
     first = runner.invoke(cli, ["retrain-all"])
     assert first.exit_code == 0, first.output
-    assert "job 1: succeeded" in first.output and "1 job(s) run" in first.output
+    assert "promoted 1" in first.output and "1 job(s) run" in first.output
     sets = client.get(f"/buildings/{building_id}/parameters", headers=headers).json()
     assert sets["current_id"] is not None
     jobs = client.get(f"/buildings/{building_id}/calibrations", headers=headers).json()["items"]

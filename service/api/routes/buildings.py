@@ -8,8 +8,9 @@ from fastapi import APIRouter, status
 
 from rcengine.building import Building
 
-from ... import repository
+from ... import adoption, repository
 from ...core.security import hash_token, new_token
+from ...schemas.adoption import ModelInUse
 from ...schemas.buildings import (
     BuildingCreate,
     BuildingCreated,
@@ -70,7 +71,10 @@ def list_buildings(ctx: ContextDep, _: AdminDep) -> BuildingList:
 def read_building(building_id: BuildingDep, ctx: ContextDep) -> BuildingRead:
     with ctx.db.session() as session:
         row = repository.building_summary(session, building_id)
-    return BuildingRead.model_validate(row, context=in_zone(row.timezone))
+        in_use = adoption.in_use(session, repository.get_building(session, building_id))
+    zone = in_zone(row.timezone)
+    body = BuildingRead.model_validate(row, context=zone)
+    return body.model_copy(update={"model": ModelInUse.model_validate(in_use, context=zone)})
 
 
 @router.post(

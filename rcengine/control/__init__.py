@@ -1,0 +1,1 @@
+"""Controllers that use a calibrated model: the reference MPC (:mod:`rcengine.control.mpc`)."""

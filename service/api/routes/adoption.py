@@ -1,0 +1,99 @@
+"""Adopt a diagnosis's model, revert to the base model, and read who did so when."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Depends
+
+from ... import adoption
+from ...schemas.adoption import ModelChangeAnswer, ModelChangeList, ModelChangeRead
+from ...schemas.common import error_responses, id_in_path, in_zone
+from ..answers import building_zone
+from ..deps import BuildingDep, ContextDep, TokenBuildingDep
+
+router = APIRouter(prefix="/buildings", tags=["diagnoses"])
+
+ADOPT_TEXT = (
+    "Makes the diagnosis's final model (the base model plus every accepted extension, with its "
+    "learnt schedules, clock, orientations and ground settings) the building's model: every "
+    "calibration fits it from now on, and one starts at once (`calibration_job_id`). Its set is "
+    "served only if it beats the current set on the held-out day, as any calibration's, so "
+    "adopting a model that does not forecast better changes nothing served. Adopting the "
+    "adopted diagnosis again changes nothing (`changed: false`); every call is audited. 422 if "
+    "the diagnosis accepted no extension."
+)
+REVERT_TEXT = (
+    "Back to the base model: calibrations fit it from now on (one starts at once), and the "
+    "base-model set served before the adoption is served again now. Reverting a base model "
+    "changes nothing (`changed: false`); every call is audited."
+)
+
+
+async def _actor(caller: TokenBuildingDep) -> str:
+    """Who the audit row names: the admin token or the building's own."""
+    return adoption.ADMIN if caller is None else adoption.BUILDING
+
+
+ActorDep = Annotated[str, Depends(_actor)]
+
+
+@router.post(
+    "/{building_id}/diagnoses/{diagnosis_id}/adopt",
+    response_model=ModelChangeAnswer,
+    summary="Adopt a diagnosis's model as the building's model",
+    description=ADOPT_TEXT,
+    responses=error_responses(401, 404, 422),
+)
+def adopt_diagnosis(
+    building_id: BuildingDep,
+    diagnosis_id: Annotated[int, id_in_path("Diagnosis", 3)],
+    ctx: ContextDep,
+    actor: ActorDep,
+) -> ModelChangeAnswer:
+    with ctx.db.write() as session:
+        change = adoption.adopt(session, building_id, diagnosis_id, actor)
+    return _answer(ctx, building_id, change)
+
+
+@router.post(
+    "/{building_id}/model/revert",
+    response_model=ModelChangeAnswer,
+    summary="Revert the building to its base model",
+    description=REVERT_TEXT,
+    responses=error_responses(401, 404),
+)
+def revert_model(building_id: BuildingDep, ctx: ContextDep, actor: ActorDep) -> ModelChangeAnswer:
+    with ctx.db.write() as session:
+        change = adoption.revert(session, building_id, actor)
+    return _answer(ctx, building_id, change)
+
+
+@router.get(
+    "/{building_id}/model/changes",
+    response_model=ModelChangeList,
+    summary="Every adopt and revert call: who, when, which diagnosis",
+    responses=error_responses(401, 404),
+)
+def model_changes(building_id: BuildingDep, ctx: ContextDep) -> ModelChangeList:
+    with ctx.db.session() as session:
+        zone = building_zone(session, building_id)
+        rows = adoption.history(session, building_id)
+        items = [ModelChangeRead.model_validate(r, context=zone) for r in rows]
+    return ModelChangeList(items=items)
+
+
+def _answer(ctx: ContextDep, building_id: int, change: adoption.Change) -> ModelChangeAnswer:
+    """Start the calibration a change calls for, then answer the audited call."""
+    adoption.calibrate_now(ctx.runner, building_id, change)
+    return change_answer(ctx, building_id, change.record.id)
+
+
+def change_answer(ctx: ContextDep, building_id: int, change_id: int) -> ModelChangeAnswer:
+    with ctx.db.session() as session:
+        building = adoption.repository.get_building(session, building_id)
+        record = session.get(adoption.ModelChangeRecord, change_id)
+        in_use = adoption.in_use(session, building)
+        zone = in_zone(building.timezone)
+        body = ModelChangeRead.model_validate(record, context=zone).model_dump()
+        return ModelChangeAnswer.model_validate({**body, "model_in_use": in_use}, context=zone)
