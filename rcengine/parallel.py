@@ -9,6 +9,7 @@ parent's own small factorisations run faster on one thread too.
 
 from __future__ import annotations
 
+import multiprocessing
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
@@ -19,6 +20,12 @@ from threadpoolctl import threadpool_limits
 def one_blas_thread() -> threadpool_limits:
     """Limit BLAS/OpenMP to one thread (for good, or within a ``with`` block)."""
     return threadpool_limits(limits=1)
+
+
+def can_start_processes() -> bool:
+    """Whether this process may start worker processes: a daemonic one (a Dask worker, a
+    multiprocessing.Pool worker) may not, and must do its share of the work itself."""
+    return not multiprocessing.current_process().daemon
 
 
 def _start_worker(initializer: Callable[..., None] | None, initargs: tuple[Any, ...]) -> None:

@@ -19,7 +19,7 @@ from rcengine.exceptions import ConvergenceWarning
 from rcengine.kalman import kalman_filter
 from rcengine.metrics import rmse
 from rcengine.network import CompiledNetwork, RCNetwork
-from rcengine.parallel import process_pool
+from rcengine.parallel import can_start_processes, process_pool
 from rcengine.signals import SignalOptions, prepare
 
 # A fold's refit stays within this factor of the fit on the training half (``trust_region``). [-]
@@ -210,8 +210,9 @@ def trust_region(
 
 
 def fit_many(jobs: list[FitJob], workers: int) -> list[Fit]:
-    """Run independent fits, on up to ``workers`` processes (1: in this process)."""
-    if workers <= 1 or len(jobs) <= 1:
+    """Run independent fits, on up to ``workers`` processes (1, or where this process may not
+    start any, ``parallel.can_start_processes``: in this process)."""
+    if workers <= 1 or len(jobs) <= 1 or not can_start_processes():
         return [job.run() for job in jobs]
     with process_pool(min(workers, len(jobs))) as pool:
         return list(pool.map(FitJob.run, jobs))

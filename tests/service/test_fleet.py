@@ -20,14 +20,16 @@ import pytest
 from sqlalchemy import select
 
 from benchmarks.fleet import FleetMaker, store_fleet
-from service import repository
+from service import diagnosis, repository
 from service.backends import PoolBackend
 from service.core.config import Settings
 from service.core.db import Database
+from service.diagnosis import DiagnosisSpec
 from service.fleet import retrain_all
-from service.jobs import INTERRUPTED, JobRunner, announce_mode, queue_retraining
+from service.jobs import INTERRUPTED, JobRunner, announce_mode, kinds, queue_retraining
 from service.models import (
     CALIBRATION,
+    DIAGNOSIS,
     FAILED,
     QUEUED,
     RUNNING,
@@ -310,3 +312,43 @@ def test_a_dask_scheduler_must_be_an_address_or_local():
     assert fleet_settings("sqlite://", dask_scheduler="local").dask_scheduler == "local"
     with pytest.raises(ValueError, match="tcp://host:8786"):
         fleet_settings("sqlite://", dask_scheduler="scheduler-host")
+
+
+@pytest.mark.slow
+def test_a_diagnosis_on_dask_reports_what_the_service_process_reports(tmp_path, fleet, cluster):
+    """The service reads the rows and stores the report; the diagnosis itself runs on a Dask
+    worker, which touches no database, and gives the report the in-process run gives."""
+    settings = fleet_settings(f"sqlite:///{tmp_path / 'fleet.db'}", diagnosis_preset="modestpy")
+    db = stored(settings.database_url, fleet, 1)
+    runner = JobRunner(settings, db, _Unclosed(cluster))
+    try:
+        with db.session() as session:
+            building_id = session.scalars(select(BuildingRecord.id)).one()
+        job = runner.create_diagnosis(building_id, "basic", DiagnosisSpec(), "api")
+        deadline = time.monotonic() + 120.0
+        while (record := _job(db, job.id)).status in (QUEUED, RUNNING):
+            assert time.monotonic() < deadline, "the diagnosis on Dask did not finish"
+            time.sleep(0.2)
+        assert record.status == SUCCEEDED, record.error
+        with db.session() as session:
+            on_dask = repository.latest_diagnosis(session, building_id).report
+        here = diagnosis.work(db, record, kinds(settings)[DIAGNOSIS][1])
+    finally:
+        runner.shutdown()
+        db.dispose()
+    for key in ("verdict", "baseline", "findings", "final"):
+        assert _without_times(on_dask[key]) == _without_times(here.record.report[key]), key
+
+
+def _job(db: Database, job_id: int) -> JobRecord:
+    with db.session() as session:
+        return session.get(JobRecord, job_id)
+
+
+def _without_times(value: object) -> object:
+    """``value`` without wall-clock durations, which differ between two runs of one diagnosis."""
+    if isinstance(value, dict):
+        return {k: _without_times(v) for k, v in value.items() if not k.startswith("wall_time")}
+    if isinstance(value, list):
+        return [_without_times(v) for v in value]
+    return value
