@@ -235,12 +235,14 @@ def test_two_service_processes_run_the_nightly_pass_once_per_building(postgres_u
 
 STUCK_REPLICA = textwrap.dedent(
     """
-    import sys, threading, time
+    import os, sys, threading, time
     from service.core.db import Database
     from service.jobs import LeaseTerms, drain
 
     def stuck(db, job, options):  # a fit that never ends
-        print(job.id, flush=True)
+        # One write per line: print's separate writes of the id and the newline interleave
+        # between the two threads.
+        os.write(1, f"{job.id}\\n".encode())
         time.sleep(3600)
 
     db = Database(sys.argv[1])
