@@ -151,7 +151,21 @@ def _has_signal(net: RCNetwork, prefix: str) -> bool:
     return any(s.startswith(prefix) for s in net.signals)
 
 
-def _facade(azimuth: float, tilt: float) -> str:
+def _areas_by_orientation(surfaces: list) -> dict[str, float]:
+    areas: dict[str, float] = {}
+    for s in surfaces:
+        key = orientation_key(s.azimuth, s.tilt)
+        areas[key] = areas.get(key, 0.0) + s.area
+    return areas
+
+
+def _facade_tilt(key: str) -> float:
+    return float(key.split("_")[1])
+
+
+def _facade(key: str) -> str:
+    """The facade an orientation key (``orientation_key``) names: a compass point, or "roof"."""
+    azimuth, tilt = (float(v) for v in key.split("_"))
     if tilt < 30:
         return "roof"
     names = [
@@ -182,11 +196,7 @@ def _solar_by_orientation(
     surfaces = ctx.building.windows if kind == "window" else ctx.building.walls
     total = SOLAR_WINDOW if kind == "window" else SOLAR_OPAQUE
     net = ctx.network.copy(_name(ctx.network, effect))
-    groups: dict[str, tuple[str, float]] = {}
-    for s in surfaces:
-        key = orientation_key(s.azimuth, s.tilt)
-        area = groups.get(key, ("", 0.0))[1] + s.area
-        groups[key] = (_facade(s.azimuth, s.tilt), area)
+    groups = {k: (_facade(k), a) for k, a in _areas_by_orientation(surfaces).items()}
     params, inputs = [], []
     for key, (facade, area) in groups.items():
         name = f"{'g' if kind == 'window' else 'a'}_{kind}_{key}"
@@ -210,23 +220,11 @@ def _solar_by_orientation(
     )
 
 
-def _areas_by_orientation(surfaces: list) -> dict[str, float]:
-    areas: dict[str, float] = {}
-    for s in surfaces:
-        key = orientation_key(s.azimuth, s.tilt)
-        areas[key] = areas.get(key, 0.0) + s.area
-    return areas
-
-
 def facade_areas(building: Building) -> dict[str, float]:
     """Gross area of each orientation's surfaces, glazing and opaque: the most glazing an
     orientation could have. [m²]"""
     glazed, opaque = (_areas_by_orientation(s) for s in (building.windows, building.walls))
     return {k: glazed.get(k, 0.0) + opaque.get(k, 0.0) for k in {*glazed, *opaque}}
-
-
-def _facade_tilt(key: str) -> float:
-    return float(key.split("_")[1])
 
 
 def window_solar_gains(ctx: Context) -> Extension | Skipped:
@@ -258,8 +256,7 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
     net = ctx.network.copy(_name(ctx.network, effect))
     orientations, inputs = {}, []
     for key in [*glazed, *undeclared]:
-        azimuth, tilt = (float(v) for v in key.split("_"))
-        facade, declared = _facade(azimuth, tilt), glazed.get(key, 0.0)
+        facade, declared = _facade(key), glazed.get(key, 0.0)
         if declared:
             signal, upper = SOLAR_WINDOW, facades[key] / declared
             meaning = (
