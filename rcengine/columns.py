@@ -75,6 +75,15 @@ SKY_DELTA = "sky_delta"  # T_sky − t_out [K]
 # Weekly schedules stored in the signal options, by name; each plays back as sched_<name> [-].
 VENT_SCHEDULE = "vent"
 GAINS_SCHEDULE = "gains"
+# The contract columns each derived signal above is computed from: what a forecast's future rows
+# must hold for a model's inputs (the solar signals need GHI; a schedule, the clock alone).
+DERIVED_FROM: dict[str, tuple[str, ...]] = {
+    WIND_LOSS: (T_OUT, WIND_SPEED),
+    VENT_LOSS: (T_OUT,),
+    T_GROUND: (T_OUT,),
+    UNIT: (),
+    SKY_DELTA: (T_OUT, GHI),
+}
 
 
 def schedule_signal_name(schedule: str) -> str:

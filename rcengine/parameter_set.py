@@ -32,7 +32,11 @@ FORMAT_VERSION = 1
 
 @dataclass(frozen=True)
 class ParameterSet:
-    """A fitted model: network, values, building, signal options and provenance."""
+    """A fitted model: the ``network`` of ``model`` and its parameter ``values`` (by name, in
+    the parameters' units), the ``building`` and the ``signals`` options it was fitted with, and
+    its provenance: ``fit`` (training window, estimator settings, cost and effort, initial
+    states; the noise model of a likelihood fit), ``metrics`` ("train"; "holdout" once scored on
+    a held-out day), ``engine_version`` and ``created_at`` (UTC, ISO 8601)."""
 
     model: str
     network: RCNetwork
@@ -169,8 +173,7 @@ def _missing_entry(data: object, exc: KeyError) -> str:
     """What a parameter document lacks, and what the file probably is instead."""
     found = "" if not isinstance(data, dict) else f"; found {sorted(data)[:8]}"
     hint = (
-        " — this looks like a building description, not a parameter file written by "
-        "`rcengine fit`"
+        " — this looks like a building description, not a parameter file written by `rcengine fit`"
         if isinstance(data, dict) and "location" in data and "network" not in data
         else ""
     )

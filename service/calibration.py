@@ -128,8 +128,8 @@ class Calibrated:
 
 @dataclass(frozen=True)
 class Inputs:
-    """What a fit needs from the database, read by the service (:func:`load`) so that
-    :func:`compute` can run anywhere, a Dask worker included, without a connection."""
+    """What :func:`compute` fits and scores, read by :func:`load`: the building, the rows of its
+    window and its current set; nothing past here needs a connection (a Dask worker runs it)."""
 
     building: Building
     model: str
@@ -240,7 +240,10 @@ def holdout_score(pset: ParameterSet, frame: pd.DataFrame, window: Window) -> Fi
 
 
 def days_used(
-    requested: int, first_stored: datetime, last_measured: datetime, step_s: float,
+    requested: int,
+    first_stored: datetime,
+    last_measured: datetime,
+    step_s: float,
     holdout_h: float = HOLDOUT_H,
 ) -> int:
     """The days a calibration asked for ``requested`` days fits: at most the whole or partial

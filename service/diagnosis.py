@@ -161,8 +161,8 @@ class Diagnosed:
 
 @dataclass(frozen=True)
 class Inputs:
-    """What a diagnosis needs from the database, read by the service (:func:`load`), so that
-    :func:`compute` can run anywhere, a Dask worker included, without a connection."""
+    """The building and the stored rows of the planned window, read by :func:`load`;
+    :func:`compute` needs nothing else, so it runs anywhere, a Dask worker included."""
 
     building_id: int
     job_id: int

@@ -116,27 +116,6 @@ def execute(
     return run_leased(db, lease, work, options, terms)
 
 
-def execute_next(
-    db: Database,
-    kind: str,
-    work: Work,
-    options: Any,
-    terms: LeaseTerms,
-    building_ids: tuple[int, ...] = (),
-) -> tuple[int, str] | None:
-    """Claim the oldest queued job of ``kind`` and run it; (job id, final status), or None when
-    the queue is empty (other processes may be claiming from it at the same time)."""
-    with db.write() as session:
-        lease = repository.claim_next_job(session, kind, terms.owner, terms.seconds, building_ids)
-    if lease is None:
-        return None
-    try:
-        return lease.job_id, run_leased(db, lease, work, options, terms)
-    except LeaseLostError as exc:  # the job was failed when its lease expired
-        log.warning("job run fenced off", extra={"job_id": lease.job_id, "error": str(exc)})
-        return lease.job_id, FAILED
-
-
 def drain(
     db: Database,
     kind: str,
@@ -145,11 +124,23 @@ def drain(
     terms: LeaseTerms,
     building_ids: tuple[int, ...] = (),
 ) -> dict[int, str]:
-    """Claim and run queued jobs of ``kind`` until none is left; {job id: final status}."""
+    """Claim the oldest queued job of ``kind`` and run it, until none is left (other processes
+    may be claiming from the same queue at the same time); {job id: final status}."""
     done: dict[int, str] = {}
-    while (ran := execute_next(db, kind, work, options, terms, building_ids)) is not None:
-        done[ran[0]] = ran[1]
+    while (lease := _claim_next(db, kind, terms, building_ids)) is not None:
+        try:
+            done[lease.job_id] = run_leased(db, lease, work, options, terms)
+        except LeaseLostError as exc:  # the job was failed when its lease expired
+            log.warning("job run fenced off", extra={"job_id": lease.job_id, "error": str(exc)})
+            done[lease.job_id] = FAILED
     return done
+
+
+def _claim_next(
+    db: Database, kind: str, terms: LeaseTerms, building_ids: tuple[int, ...]
+) -> repository.Lease | None:
+    with db.write() as session:
+        return repository.claim_next_job(session, kind, terms.owner, terms.seconds, building_ids)
 
 
 def run_leased(

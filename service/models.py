@@ -24,6 +24,7 @@ from sqlalchemy import (
     text,
 )
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+from sqlalchemy.sql.elements import TextClause
 from sqlalchemy.types import TypeDecorator
 
 from rcengine.columns import NUMERIC_COLUMNS, TIME
@@ -34,6 +35,8 @@ ACTIVE_JOB_STATUSES = (QUEUED, RUNNING)
 PROMOTED, REJECTED = "promoted", "rejected"
 # What a job does: re-estimate the parameters, or diagnose the model-data mismatch.
 CALIBRATION, DIAGNOSIS = "calibration", "diagnosis"
+# Where a building's jobs of each kind are started and listed: /buildings/{id}/<collection>.
+JOB_COLLECTIONS = {CALIBRATION: "calibrations", DIAGNOSIS: "diagnoses"}
 # Parameter-set status: the one in use, one it replaced, or one that lost on the held-out day.
 CURRENT, SUPERSEDED = "current", "superseded"
 
@@ -61,10 +64,24 @@ class UTCDateTime(TypeDecorator):
         return value.replace(tzinfo=UTC) if value.tzinfo is None else value.astimezone(UTC)
 
 
-def unique_where(name: str, *columns: str, where: str) -> Index:
-    """A unique index over the rows where ``where`` holds (partial, on SQLite and PostgreSQL)."""
+# --- shared with the migrations: what they create depends on these, so they stay as they are --
+def partial(where: str) -> dict[str, TextClause]:
+    """The keywords of an index over the rows where ``where`` holds, on SQLite and PostgreSQL."""
     condition = text(where)
-    return Index(name, *columns, unique=True, sqlite_where=condition, postgresql_where=condition)
+    return {"sqlite_where": condition, "postgresql_where": condition}
+
+
+def reference(name: str, target: str, ondelete: str) -> Column:
+    """An integer foreign key to ``target``; nullable exactly when the row outlives its target
+    (SET NULL), required when it is deleted with it (CASCADE)."""
+    return Column(
+        name, Integer(), ForeignKey(target, ondelete=ondelete), nullable=ondelete == "SET NULL"
+    )
+
+
+def unique_where(name: str, *columns: str, where: str) -> Index:
+    """A unique index over the rows where ``where`` holds."""
+    return Index(name, *columns, unique=True, **partial(where))
 
 
 class Base(DeclarativeBase):

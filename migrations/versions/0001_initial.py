@@ -1,28 +1,22 @@
 """Initial schema: buildings, measurements, jobs, parameter sets, admin token.
 
-Revision ID: 0001
-Revises:
 Create Date: 2026-11-22
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import sqlalchemy as sa
 from alembic import op
 
 from rcengine.columns import DHI, DNI, GHI, Q_HVAC, Q_LIGHT, Q_OCC, T_IN, T_OUT, TIME, WIND_SPEED
-from service.models import UTCDateTime
+from service.models import UTCDateTime, partial, reference
 
 revision: str = "0001"
 down_revision: str | None = None
-branch_labels: str | Sequence[str] | None = None
-depends_on: str | Sequence[str] | None = None
 
 # The contract columns as of this revision (a later contract column needs a new migration).
 _MEASURED = (T_IN, T_OUT, GHI, Q_HVAC, DNI, DHI, Q_OCC, Q_LIGHT, WIND_SPEED)
-_ACTIVE = sa.text("status IN ('queued', 'running')")
+_ACTIVE = "status IN ('queued', 'running')"
 
 
 def upgrade() -> None:
@@ -54,12 +48,7 @@ def upgrade() -> None:
     op.create_table(
         "jobs",
         sa.Column("id", sa.Integer(), primary_key=True),
-        sa.Column(
-            "building_id",
-            sa.Integer(),
-            sa.ForeignKey("buildings.id", ondelete="CASCADE"),
-            nullable=False,
-        ),
+        reference("building_id", "buildings.id", "CASCADE"),
         sa.Column("status", sa.String(16), nullable=False),
         sa.Column("outcome", sa.String(16), nullable=True),
         sa.Column("trigger", sa.String(16), nullable=False),
@@ -73,26 +62,14 @@ def upgrade() -> None:
         sa.Column("details", sa.JSON(), nullable=True),
     )
     op.create_index(
-        "uq_jobs_active_building",
-        "jobs",
-        ["building_id"],
-        unique=True,
-        sqlite_where=_ACTIVE,
-        postgresql_where=_ACTIVE,
+        "uq_jobs_active_building", "jobs", ["building_id"], unique=True, **partial(_ACTIVE)
     )
     op.create_index("ix_jobs_building_created", "jobs", ["building_id", "created_at"])
     op.create_table(
         "parameter_sets",
         sa.Column("id", sa.Integer(), primary_key=True),
-        sa.Column(
-            "building_id",
-            sa.Integer(),
-            sa.ForeignKey("buildings.id", ondelete="CASCADE"),
-            nullable=False,
-        ),
-        sa.Column(
-            "job_id", sa.Integer(), sa.ForeignKey("jobs.id", ondelete="SET NULL"), nullable=True
-        ),
+        reference("building_id", "buildings.id", "CASCADE"),
+        reference("job_id", "jobs.id", "SET NULL"),
         sa.Column("model", sa.String(100), nullable=False),
         sa.Column("status", sa.String(16), nullable=False),
         sa.Column("is_current", sa.Boolean(), nullable=False),
@@ -111,8 +88,7 @@ def upgrade() -> None:
         "parameter_sets",
         ["building_id"],
         unique=True,
-        sqlite_where=sa.text("is_current"),
-        postgresql_where=sa.text("is_current"),
+        **partial("is_current"),
     )
     op.create_index(
         "ix_parameter_sets_building_created", "parameter_sets", ["building_id", "created_at"]

@@ -2,26 +2,20 @@
 
 Existing jobs become calibrations. Downgrading deletes the diagnosis jobs and reports.
 
-Revision ID: 0002
-Revises: 0001
 Create Date: 2026-11-29
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import sqlalchemy as sa
 from alembic import op
 
-from service.models import UTCDateTime
+from service.models import UTCDateTime, partial, reference
 
 revision: str = "0002"
 down_revision: str | None = "0001"
-branch_labels: str | Sequence[str] | None = None
-depends_on: str | Sequence[str] | None = None
 
-_ACTIVE = sa.text("status IN ('queued', 'running')")
+_ACTIVE = "status IN ('queued', 'running')"
 
 
 def upgrade() -> None:
@@ -36,21 +30,13 @@ def upgrade() -> None:
         "jobs",
         ["building_id", "kind"],
         unique=True,
-        sqlite_where=_ACTIVE,
-        postgresql_where=_ACTIVE,
+        **partial(_ACTIVE),
     )
     op.create_table(
         "diagnoses",
         sa.Column("id", sa.Integer(), primary_key=True),
-        sa.Column(
-            "building_id",
-            sa.Integer(),
-            sa.ForeignKey("buildings.id", ondelete="CASCADE"),
-            nullable=False,
-        ),
-        sa.Column(
-            "job_id", sa.Integer(), sa.ForeignKey("jobs.id", ondelete="SET NULL"), nullable=True
-        ),
+        reference("building_id", "buildings.id", "CASCADE"),
+        reference("job_id", "jobs.id", "SET NULL"),
         sa.Column("model", sa.String(100), nullable=False),
         sa.Column("window_start", UTCDateTime(), nullable=False),
         sa.Column("window_end", UTCDateTime(), nullable=False),
@@ -69,12 +55,7 @@ def downgrade() -> None:
     op.execute(sa.text("DELETE FROM jobs WHERE kind = 'diagnosis'"))
     op.drop_index("uq_jobs_active_building_kind", table_name="jobs")
     op.create_index(
-        "uq_jobs_active_building",
-        "jobs",
-        ["building_id"],
-        unique=True,
-        sqlite_where=_ACTIVE,
-        postgresql_where=_ACTIVE,
+        "uq_jobs_active_building", "jobs", ["building_id"], unique=True, **partial(_ACTIVE)
     )
     # Plain ALTER TABLE … DROP COLUMN (SQLite ≥ 3.35): a batch copy of the table would fire
     # the ON DELETE SET NULL of parameter_sets.job_id when the old table is dropped.

@@ -1,34 +1,17 @@
 """Adopted models: the building's model specification and the audit of adopt / revert calls.
 
-Revision ID: 0004
-Revises: 0003
 Create Date: 2026-11-23
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import sqlalchemy as sa
 from alembic import op
 
-from service.models import UTCDateTime
+from service.models import UTCDateTime, reference
 
 revision: str = "0004"
 down_revision: str | None = "0003"
-branch_labels: str | Sequence[str] | None = None
-depends_on: str | Sequence[str] | None = None
-
-
-def _reference(name: str, target: str, ondelete: str) -> sa.Column:
-    """An integer foreign key to ``target``; nullable exactly when the row outlives its target
-    (SET NULL), required when it is deleted with it (CASCADE)."""
-    return sa.Column(
-        name,
-        sa.Integer(),
-        sa.ForeignKey(target, ondelete=ondelete),
-        nullable=ondelete == "SET NULL",
-    )
 
 
 def upgrade() -> None:
@@ -36,13 +19,13 @@ def upgrade() -> None:
     op.create_table(
         "model_changes",
         sa.Column("id", sa.Integer(), primary_key=True),
-        _reference("building_id", "buildings.id", "CASCADE"),
+        reference("building_id", "buildings.id", "CASCADE"),
         sa.Column("action", sa.String(16), nullable=False),
-        _reference("diagnosis_id", "diagnoses.id", "SET NULL"),
+        reference("diagnosis_id", "diagnoses.id", "SET NULL"),
         sa.Column("model", sa.String(200), nullable=True),
         sa.Column("actor", sa.String(32), nullable=False),
         sa.Column("changed", sa.Boolean(), nullable=False),
-        _reference("calibration_job_id", "jobs.id", "SET NULL"),
+        reference("calibration_job_id", "jobs.id", "SET NULL"),
         sa.Column("detail", sa.JSON(), nullable=True),
         sa.Column("created_at", UTCDateTime(), nullable=False),
     )

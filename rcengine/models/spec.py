@@ -27,17 +27,13 @@ import pandas as pd
 from rcengine import __version__
 from rcengine.building import Building
 from rcengine.columns import (
+    DERIVED_FROM,
     GHI,
     NUMERIC_COLUMNS,
-    SKY_DELTA,
     SOLAR_OPAQUE,
     SOLAR_WINDOW,
     T_GROUND,
     T_OUT,
-    UNIT,
-    VENT_LOSS,
-    WIND_LOSS,
-    WIND_SPEED,
 )
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.jsonable import jsonable, read_json
@@ -50,16 +46,6 @@ SPEC_VERSION = 1
 # with an upgrade of the older documents in ``_upgrade``.
 READABLE_VERSIONS = (1,)
 BASE = "base"  # source of a specification that is just a library model
-
-# Contract columns each derived signal is computed from (rcengine.signals.derived): what a
-# forecast's future rows must hold for the model's inputs.
-_DERIVED_FROM: dict[str, tuple[str, ...]] = {
-    WIND_LOSS: (T_OUT, WIND_SPEED),
-    VENT_LOSS: (T_OUT,),
-    T_GROUND: (T_OUT,),
-    UNIT: (),
-    SKY_DELTA: (T_OUT, GHI),
-}
 
 
 def building_key(building: Building) -> str:
@@ -76,8 +62,8 @@ def columns_needed(inputs: Iterable[str]) -> list[str]:
     for name in inputs:
         if name in NUMERIC_COLUMNS:
             needed.append(name)
-        elif name in _DERIVED_FROM:
-            needed.extend(_DERIVED_FROM[name])
+        elif name in DERIVED_FROM:
+            needed.extend(DERIVED_FROM[name])
         elif name.startswith((SOLAR_WINDOW, SOLAR_OPAQUE)):
             needed.append(GHI)  # dni/dhi are used when given, decomposed from ghi otherwise
         # sched_<name>: a stored schedule, played back from the clock alone.

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from datetime import date, timedelta
+from typing import Any
 
 from .idf import idf_object
 from .library import (
@@ -167,89 +168,45 @@ class Archetype:
         return self.floor_area * self.storey_height
 
 
-LIGHT = Archetype(
-    name="light",
-    summary="Light timber-frame pavilion, 216 m², one zone",
-    zone_name="Pavilion",
-    width=12.0,
-    depth=18.0,
-    storey_height=3.0,
-    storeys=1,
-    rows=1,
-    wall=TIMBER_WALL,
-    roof=LIGHT_ROOF,
-    floor=CRAWL_FLOOR,
-    floor_boundary="Outdoors",
-    intermediate_floor=None,
-    partition=None,
-    internal_mass=PARTITION,
-    mass_per_floor=1.0,
-    glazing=SimpleGlazing("Double clear U2.7", 2.7, 0.70, 0.78),
-    sill=0.8,
-    head=2.4,
-    m2_per_person=12.0,
-    lights_w_m2=8.0,
-    infiltration_ach=0.4,
-    occupied_setpoint=21.0,
-    setback=15.0,
-    heated_hours=(6, 19),
-    capacity_factor=1.3,
-)
-HEAVY = Archetype(
-    name="heavy",
-    summary="Heavy two-storey masonry office, 576 m² in four zones",
-    zone_name="Office",
-    width=24.0,
-    depth=12.0,
-    storey_height=3.3,
-    storeys=2,
-    rows=2,
-    wall=MASONRY_WALL,
-    roof=CONCRETE_ROOF,
-    floor=CONCRETE_FLOOR,
-    floor_boundary="Adiabatic",
-    intermediate_floor=CONCRETE_FLOOR,
-    partition=BRICK_PARTITION,
-    internal_mass=BRICK_PARTITION,
-    mass_per_floor=0.6,
-    glazing=SimpleGlazing("Double low-e U1.4", 1.4, 0.55, 0.70),
-    sill=0.9,
-    head=2.5,
-    m2_per_person=10.0,
-    lights_w_m2=7.0,
-    infiltration_ach=0.3,
-    occupied_setpoint=20.0,
-    setback=16.0,
-    heated_hours=(5, 19),
-    capacity_factor=1.1,
-)
-OPEN_PLAN = Archetype(
-    name="open_plan",
-    summary="Steel-frame open-plan floor over an exposed concrete slab, 700 m², one zone",
-    zone_name="Open plan",
-    width=35.0,
-    depth=20.0,
-    storey_height=4.0,
-    storeys=1,
-    rows=1,
-    wall=PANEL_WALL,
-    roof=DECK_ROOF,
-    floor=EXPOSED_SLAB,
-    floor_boundary="Adiabatic",
-    intermediate_floor=None,
-    partition=None,
-    internal_mass=PARTITION,
-    mass_per_floor=0.3,
-    glazing=SimpleGlazing("Double low-e U1.8", 1.8, 0.60, 0.70),
-    sill=1.0,
-    head=3.2,
-    m2_per_person=12.0,
-    lights_w_m2=9.0,
-    infiltration_ach=0.3,
-    occupied_setpoint=21.0,
-    setback=16.0,
-    heated_hours=(6, 19),
-    capacity_factor=1.2,
+# One row per field, one column per archetype (light, heavy, open_plan), to read side by side.
+_TABLE: dict[str, tuple[Any, Any, Any]] = {
+    "name": ("light", "heavy", "open_plan"),
+    "summary": (
+        "Light timber-frame pavilion, 216 m², one zone",
+        "Heavy two-storey masonry office, 576 m² in four zones",
+        "Steel-frame open-plan floor over an exposed concrete slab, 700 m², one zone",
+    ),
+    "zone_name": ("Pavilion", "Office", "Open plan"),
+    "width": (12.0, 24.0, 35.0),
+    "depth": (18.0, 12.0, 20.0),
+    "storey_height": (3.0, 3.3, 4.0),
+    "storeys": (1, 2, 1),
+    "rows": (1, 2, 1),
+    "wall": (TIMBER_WALL, MASONRY_WALL, PANEL_WALL),
+    "roof": (LIGHT_ROOF, CONCRETE_ROOF, DECK_ROOF),
+    "floor": (CRAWL_FLOOR, CONCRETE_FLOOR, EXPOSED_SLAB),
+    "floor_boundary": ("Outdoors", "Adiabatic", "Adiabatic"),
+    "intermediate_floor": (None, CONCRETE_FLOOR, None),
+    "partition": (None, BRICK_PARTITION, None),
+    "internal_mass": (PARTITION, BRICK_PARTITION, PARTITION),
+    "mass_per_floor": (1.0, 0.6, 0.3),
+    "glazing": (
+        SimpleGlazing("Double clear U2.7", 2.7, 0.70, 0.78),
+        SimpleGlazing("Double low-e U1.4", 1.4, 0.55, 0.70),
+        SimpleGlazing("Double low-e U1.8", 1.8, 0.60, 0.70),
+    ),
+    "sill": (0.8, 0.9, 1.0),
+    "head": (2.4, 2.5, 3.2),
+    "m2_per_person": (12.0, 10.0, 12.0),
+    "lights_w_m2": (8.0, 7.0, 9.0),
+    "infiltration_ach": (0.4, 0.3, 0.3),
+    "occupied_setpoint": (21.0, 20.0, 21.0),
+    "setback": (15.0, 16.0, 16.0),
+    "heated_hours": ((6, 19), (5, 19), (6, 19)),
+    "capacity_factor": (1.3, 1.1, 1.2),
+}
+LIGHT, HEAVY, OPEN_PLAN = (
+    Archetype(**{field: column[i] for field, column in _TABLE.items()}) for i in range(3)
 )
 ARCHETYPES = {a.name: a for a in (LIGHT, HEAVY, OPEN_PLAN)}
 

@@ -18,7 +18,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from .. import repository
 from ..context import ServiceContext
 from ..core.security import hash_token, same_hash
-from ..schemas.common import id_in_path
+from ..schemas.common import error_responses, id_in_path
 
 bearer = HTTPBearer(
     auto_error=False,
@@ -85,6 +85,10 @@ async def building_access(
     return building_id
 
 
-AdminDep = Annotated[None, Depends(require_admin)]
 BuildingDep = Annotated[int, Depends(building_access)]
 TokenBuildingDep = Annotated[int | None, Depends(token_building)]
+# In a route's ``dependencies``: the call needs the admin token (and nothing from it).
+ADMIN_ONLY = Depends(require_admin)
+# What any call may answer about a resource it names: no valid token (401), or a resource the
+# token cannot reach (404); a router whose every call answers only these declares them once.
+ACCESS_ERRORS = error_responses(401, 404)

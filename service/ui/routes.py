@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import secrets
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, Form, Request, status
 from fastapi.concurrency import run_in_threadpool
@@ -19,7 +19,7 @@ from fastapi.templating import Jinja2Templates
 from .. import repository
 from ..diagnosis import DiagnosisSpec
 from ..errors import ConflictError, NotFoundError
-from ..models import CALIBRATION, DIAGNOSIS
+from ..models import CALIBRATION, DIAGNOSIS, JOB_COLLECTIONS
 from ..schemas.common import id_in_path
 from . import views
 from .auth import ContextDep, SessionDep, reachable, store, who
@@ -179,45 +179,35 @@ def diagnosis_report(
 
 
 # --- actions ----------------------------------------------------------------------------------
-@router.post("/buildings/{building_id}/calibrations")
-def start_calibration(
-    request: Request,
-    building_id: IdPath,
-    session: SessionDep,
-    ctx: ContextDep,
-    csrf: Annotated[str, Form()] = "",
-) -> Response:
-    return _start(request, building_id, session, ctx, csrf, "calibration")
+def _route_start(kind: str, collection: str) -> None:
+    """Route the building page's button that queues a job of ``kind``."""
+
+    @router.post(f"/buildings/{{building_id}}/{collection}", name=f"start_{kind}")
+    def start(
+        request: Request,
+        building_id: IdPath,
+        session: SessionDep,
+        ctx: ContextDep,
+        csrf: Annotated[str, Form()] = "",
+    ) -> Response:
+        if not session.csrf_ok(csrf):
+            return render(request, "error.html", 403, session, message="invalid form token")
+        try:
+            reachable(ctx, session, building_id)
+        except NotFoundError as exc:
+            return not_found(request, session, exc)
+        model = ctx.settings.model
+        try:
+            if kind == DIAGNOSIS:
+                job = ctx.runner.create_diagnosis(building_id, model, DiagnosisSpec(), TRIGGER)
+            else:
+                days = ctx.settings.training_days
+                job = ctx.runner.create_calibration(building_id, model, days, TRIGGER)
+            session.flash = f"{kind} job {job.id} queued"
+        except ConflictError as exc:
+            session.flash = f"not started: {exc}"
+        return redirect(f"{PREFIX}/buildings/{building_id}#jobs")
 
 
-@router.post("/buildings/{building_id}/diagnoses")
-def start_diagnosis(
-    request: Request,
-    building_id: IdPath,
-    session: SessionDep,
-    ctx: ContextDep,
-    csrf: Annotated[str, Form()] = "",
-) -> Response:
-    return _start(request, building_id, session, ctx, csrf, DIAGNOSIS)
-
-
-def _start(
-    request: Request, building_id: int, session: Session, ctx: Any, csrf: str, kind: str
-) -> Response:
-    if not session.csrf_ok(csrf):
-        return render(request, "error.html", 403, session, message="invalid form token")
-    try:
-        reachable(ctx, session, building_id)
-    except NotFoundError as exc:
-        return not_found(request, session, exc)
-    model = ctx.settings.model
-    try:
-        if kind == DIAGNOSIS:
-            job = ctx.runner.create_diagnosis(building_id, model, DiagnosisSpec(), TRIGGER)
-        else:
-            days = ctx.settings.training_days
-            job = ctx.runner.create_calibration(building_id, model, days, TRIGGER)
-        session.flash = f"{kind} job {job.id} queued"
-    except ConflictError as exc:
-        session.flash = f"not started: {exc}"
-    return redirect(f"{PREFIX}/buildings/{building_id}#jobs")
+for kind, collection in JOB_COLLECTIONS.items():
+    _route_start(kind, collection)

@@ -109,15 +109,19 @@ def app_settings(database_url: str, **overrides: Any) -> Settings:
     )
 
 
-def module_client(
-    tmp_path_factory: pytest.TempPathFactory, name: str, **overrides: Any
-) -> Iterator[TestClient]:
-    """The body of a module-scoped ``client`` fixture: one app on a SQLite file in a fresh
-    folder ``name``, shared by the module's tests (``yield from module_client(...)``)."""
-    folder = tmp_path_factory.mktemp(name)
-    settings = app_settings(f"sqlite:///{folder / 'rcservice.db'}", **overrides)
-    with TestClient(create_app(settings)) as test_client:
-        yield test_client
+def module_client(name: str, **overrides: Any) -> Any:
+    """A module-scoped ``client`` fixture: one app on a SQLite file in a fresh folder ``name``,
+    with the settings ``overrides``, shared by the module's tests (``client = module_client(...)``
+    in the module)."""
+
+    @pytest.fixture(scope="module")
+    def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
+        folder = tmp_path_factory.mktemp(name)
+        settings = app_settings(f"sqlite:///{folder / 'rcservice.db'}", **overrides)
+        with TestClient(create_app(settings)) as test_client:
+            yield test_client
+
+    return client
 
 
 @pytest.fixture
@@ -301,11 +305,10 @@ def live_server(tmp_path: Path) -> Iterator[LiveServer]:
         server.stop()
 
 
-def run_docs_session(
-    folder: Path, heading: str, **env: str
-) -> tuple[subprocess.CompletedProcess[str], str]:
+def run_docs_session(folder: Path, heading: str, **env: str) -> str:
     """Run the first bash block after ``heading`` in docs/service.md as written, against a live
-    server in ``folder`` with the repository's data beside it; the run and the server's log.
+    server in ``folder`` with the repository's data beside it and the fast "modestpy" preset for
+    diagnoses; its output, once it has succeeded (else the test fails with the server's log).
 
     No admin token is given: the server generates one into rcservice-admin-token beside its
     database, as for `make run`, and the session reads it from there."""
@@ -313,7 +316,7 @@ def run_docs_session(
     after = docs[docs.index(heading) :]
     block = re.search(r"```bash\n(.*?)```", after, re.DOTALL).group(1)
     (folder / "data").symlink_to(ROOT / "data")
-    server = LiveServer(folder, **env)
+    server = LiveServer(folder, RCSERVICE_DIAGNOSIS_PRESET="modestpy", **env)
     server.env.pop("RCSERVICE_ADMIN_TOKEN")
     server.start()
     try:
@@ -327,7 +330,8 @@ def run_docs_session(
         )
     finally:
         server.stop()
-    return run, server.log()
+    assert run.returncode == 0, f"{run.stdout[-3000:]}\n{run.stderr[-2000:]}\n{server.log()}"
+    return run.stdout
 
 
 def rmse(a, b) -> float:

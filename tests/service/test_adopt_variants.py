@@ -29,13 +29,11 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
 import pytest
-from fastapi.testclient import TestClient
 
 from rcengine.io.timeseries import read_timeseries
 from service import diagnosis
@@ -55,15 +53,12 @@ CALIBRATION_DAYS = 14
 JOB_TIMEOUT_S = 600.0
 
 
-@pytest.fixture(scope="module")
-def client(tmp_path_factory) -> Iterator[TestClient]:
-    yield from module_client(
-        tmp_path_factory,
-        "variants",
-        preset="default",
-        training_days=CALIBRATION_DAYS,
-        max_body_bytes=64 * 1024 * 1024,
-    )
+client = module_client(
+    "variants",
+    preset="default",
+    training_days=CALIBRATION_DAYS,
+    max_body_bytes=64 * 1024 * 1024,
+)
 
 
 @pytest.fixture

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
@@ -50,16 +49,10 @@ def variant(project_data: Path) -> tuple[dict, pd.DataFrame]:
     return building, frame
 
 
-@pytest.fixture(scope="module")
-def client(tmp_path_factory) -> Iterator[TestClient]:
-    """One app for the module; diagnoses with the fast "modestpy" preset and 14 days."""
-    yield from module_client(
-        tmp_path_factory,
-        "diagnosis",
-        preset="modestpy",
-        diagnosis_preset="modestpy",
-        diagnosis_days=DAYS,
-    )
+# One app for the module; diagnoses with the fast "modestpy" preset and 14 days.
+client = module_client(
+    "diagnosis", preset="modestpy", diagnosis_preset="modestpy", diagnosis_days=DAYS
+)
 
 
 def measured_building(client: TestClient, variant) -> tuple[int, dict]:

@@ -8,11 +8,11 @@ from fastapi import APIRouter, Depends
 
 from ... import adoption
 from ...schemas.adoption import ModelChangeAnswer, ModelChangeList, ModelChangeRead
-from ...schemas.common import error_responses, id_in_path, in_zone
+from ...schemas.common import id_in_path, in_zone
 from ..answers import building_zone
-from ..deps import BuildingDep, ContextDep, TokenBuildingDep
+from ..deps import ACCESS_ERRORS, BuildingDep, ContextDep, TokenBuildingDep
 
-router = APIRouter(prefix="/buildings", tags=["diagnoses"])
+router = APIRouter(prefix="/buildings", tags=["diagnoses"], responses=ACCESS_ERRORS)
 
 ADOPT_TEXT = (
     "Makes the diagnosis's final model (the base model plus every accepted extension, with its "
@@ -40,10 +40,8 @@ ActorDep = Annotated[str, Depends(_actor)]
 
 @router.post(
     "/{building_id}/diagnoses/{diagnosis_id}/adopt",
-    response_model=ModelChangeAnswer,
     summary="Adopt a diagnosis's model as the building's model",
     description=ADOPT_TEXT,
-    responses=error_responses(401, 404, 422),
 )
 def adopt_diagnosis(
     building_id: BuildingDep,
@@ -58,10 +56,8 @@ def adopt_diagnosis(
 
 @router.post(
     "/{building_id}/model/revert",
-    response_model=ModelChangeAnswer,
     summary="Revert the building to its base model",
     description=REVERT_TEXT,
-    responses=error_responses(401, 404),
 )
 def revert_model(building_id: BuildingDep, ctx: ContextDep, actor: ActorDep) -> ModelChangeAnswer:
     with ctx.db.write() as session:
@@ -71,16 +67,14 @@ def revert_model(building_id: BuildingDep, ctx: ContextDep, actor: ActorDep) -> 
 
 @router.get(
     "/{building_id}/model/changes",
-    response_model=ModelChangeList,
     summary="Every adopt and revert call: who, when, which diagnosis",
-    responses=error_responses(401, 404),
 )
 def model_changes(building_id: BuildingDep, ctx: ContextDep) -> ModelChangeList:
     with ctx.db.session() as session:
-        zone = building_zone(session, building_id)
         rows = adoption.history(session, building_id)
-        items = [ModelChangeRead.model_validate(r, context=zone) for r in rows]
-    return ModelChangeList(items=items)
+        return ModelChangeList.model_validate(
+            {"items": rows}, context=building_zone(session, building_id)
+        )
 
 
 def _answer(ctx: ContextDep, building_id: int, change: adoption.Change) -> ModelChangeAnswer:

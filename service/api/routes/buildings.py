@@ -19,7 +19,7 @@ from ...schemas.buildings import (
     TokenRotated,
 )
 from ...schemas.common import error_responses, id_in_path, in_zone
-from ..deps import AdminDep, BuildingDep, ContextDep
+from ..deps import ADMIN_ONLY, BuildingDep, ContextDep
 
 router = APIRouter(prefix="/buildings", tags=["buildings"])
 
@@ -27,11 +27,11 @@ router = APIRouter(prefix="/buildings", tags=["buildings"])
 @router.post(
     "",
     status_code=status.HTTP_201_CREATED,
-    response_model=BuildingCreated,
     summary="Register a building (admin token); returns its id and its own token",
     responses=error_responses(401, 403, 422),
+    dependencies=[ADMIN_ONLY],
 )
-def create_building(body: BuildingCreate, ctx: ContextDep, _: AdminDep) -> BuildingCreated:
+def create_building(body: BuildingCreate, ctx: ContextDep) -> BuildingCreated:
     building = Building.from_dict(body.model_dump(exclude_none=True))
     token = new_token()
     with ctx.db.write() as session:
@@ -50,11 +50,11 @@ def create_building(body: BuildingCreate, ctx: ContextDep, _: AdminDep) -> Build
 
 @router.get(
     "",
-    response_model=BuildingList,
     summary="Every building (admin token)",
     responses=error_responses(401, 403),
+    dependencies=[ADMIN_ONLY],
 )
-def list_buildings(ctx: ContextDep, _: AdminDep) -> BuildingList:
+def list_buildings(ctx: ContextDep) -> BuildingList:
     with ctx.db.session() as session:
         rows = repository.building_summaries(session)
     return BuildingList(
@@ -64,7 +64,6 @@ def list_buildings(ctx: ContextDep, _: AdminDep) -> BuildingList:
 
 @router.get(
     "/{building_id}",
-    response_model=BuildingRead,
     summary="A building, its stored data and current parameter set",
     responses=error_responses(401, 404),
 )
@@ -79,14 +78,12 @@ def read_building(building_id: BuildingDep, ctx: ContextDep) -> BuildingRead:
 
 @router.post(
     "/{building_id}/token",
-    response_model=TokenRotated,
     summary="Replace a building's token (admin token); the old one stops working",
     responses=error_responses(401, 403, 404),
+    dependencies=[ADMIN_ONLY],
 )
 def rotate_token(
-    building_id: Annotated[int, id_in_path("Building", 1)],
-    ctx: ContextDep,
-    _: AdminDep,
+    building_id: Annotated[int, id_in_path("Building", 1)], ctx: ContextDep
 ) -> TokenRotated:
     token = new_token()
     with ctx.db.write() as session:

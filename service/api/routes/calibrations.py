@@ -20,7 +20,6 @@ router = APIRouter(tags=["calibrations"])
 @router.post(
     "/buildings/{building_id}/calibrations",
     status_code=status.HTTP_202_ACCEPTED,
-    response_model=JobRead,
     summary="Start a re-estimation on the last N days; returns the job to poll",
     description=(
         "Fits the model on the N days before the most recent measured day, scores the new and "

@@ -27,7 +27,6 @@ SERVICE_FIELDS = ("id", "building_id", "job_id", "created_at", "settings", "engi
 @router.post(
     "/{building_id}/diagnoses",
     status_code=status.HTTP_202_ACCEPTED,
-    response_model=JobRead,
     summary="Start a mismatch diagnosis of the stored measurements; returns the job to poll",
     description=(
         "Runs `rcengine diagnose` (CONTRACT.md §3) on a window of the stored rows: fits the "

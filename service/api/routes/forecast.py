@@ -41,7 +41,6 @@ StartQuery = Annotated[
 
 @router.get(
     "/{building_id}/forecast",
-    response_model=ForecastRead,
     summary="Indoor temperature forecast with the current parameter set",
     description=(
         "The unmeasured states at `start` come from a Kalman filter over the measurements "
@@ -77,7 +76,6 @@ async def forecast(
 
 @router.post(
     "/{building_id}/simulate",
-    response_model=SimulateRead,
     summary="Indoor temperature for many candidate q_hvac trajectories in one call",
     description=(
         "For an MPC optimiser: the start state as for a forecast, the stored future rows for "
@@ -95,7 +93,6 @@ def simulate(building_id: BuildingDep, body: SimulateRequest, ctx: ContextDep) -
 
 @router.get(
     "/{building_id}/model",
-    response_model=ModelRead,
     summary="Discrete state-space matrices of the current set and the current state estimate",
     description=(
         "x[k+1] = A x[k] + B u[k], t_in[k] = C x[k] + D u[k], exact zero-order hold at step "

@@ -15,7 +15,6 @@ router = APIRouter(tags=["health"])
 
 @router.get(
     "/health",
-    response_model=HealthRead,
     summary="Liveness and database check",
     responses={503: {"description": "The database does not answer"}},
 )

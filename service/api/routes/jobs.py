@@ -8,22 +8,20 @@ from typing import Annotated
 from fastapi import APIRouter, HTTPException, status
 
 from ... import repository
-from ...models import CALIBRATION, DIAGNOSIS
-from ...schemas.common import error_responses, id_in_path
+from ...models import JOB_COLLECTIONS
+from ...schemas.common import id_in_path
 from ...schemas.jobs import JobList, JobRead
 from ..answers import building_zone, job_read
-from ..deps import BuildingDep, ContextDep, TokenBuildingDep
+from ..deps import ACCESS_ERRORS, BuildingDep, ContextDep, TokenBuildingDep
 
-router = APIRouter()
+router = APIRouter(responses=ACCESS_ERRORS)
 # Jobs listed per building and kind, newest first.
 JOBS_LISTED = 100
 
 
 @router.get(
     "/jobs/{job_id}",
-    response_model=JobRead,
     summary="A calibration or diagnosis job: queued | running | succeeded | failed",
-    responses=error_responses(401, 404),
     tags=["jobs"],
 )
 def read_job(
@@ -48,14 +46,12 @@ def _jobs_of(kind: str) -> Callable[..., JobList]:
 
 
 # GET /buildings/{id}/calibrations and /buildings/{id}/diagnoses, beside the POST that starts one.
-for kind, resource in ((CALIBRATION, "calibrations"), (DIAGNOSIS, "diagnoses")):
+for kind, resource in JOB_COLLECTIONS.items():
     router.add_api_route(
         f"/buildings/{{building_id}}/{resource}",
         _jobs_of(kind),
         methods=["GET"],
-        response_model=JobList,
         summary=f"The building's {kind} jobs, newest first",
-        responses=error_responses(401, 404),
         tags=[resource],
         name=f"list_{resource}",
     )

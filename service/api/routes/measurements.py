@@ -29,12 +29,10 @@ router = APIRouter(prefix="/buildings", tags=["measurements"])
 
 _JSON_TYPES = ("application/json", "")
 _CSV_TYPES = ("text/csv", "application/csv", "text/plain")
-TimeQuery = Query(description="ISO 8601 with offset", examples=["2017-01-09T00:00:00+01:00"])
 
 
 @router.post(
     "/{building_id}/measurements",
-    response_model=UploadResult,
     summary="Upsert rows by time (JSON rows or text/csv of CONTRACT.md §1)",
     description=(
         "The whole body is validated by the engine's validator and applied in one "
@@ -71,6 +69,9 @@ def _parse_and_store(
     result = ingest.store(ctx.db, building_id, parse(body))
     with ctx.db.session() as session:
         return result, repository.get_building(session, building_id).timezone
+
+
+TimeQuery = Query(description="ISO 8601 with offset", examples=["2017-01-09T00:00:00+01:00"])
 
 
 @router.get(

@@ -7,20 +7,18 @@ from typing import Annotated, Any
 from fastapi import APIRouter
 
 from ... import repository
-from ...schemas.common import error_responses, id_in_path
+from ...schemas.common import id_in_path
 from ...schemas.parameters import ParameterSetList, ParameterSetRead
 from ..answers import building_zone
-from ..deps import BuildingDep, ContextDep
+from ..deps import ACCESS_ERRORS, BuildingDep, ContextDep
 
-router = APIRouter(prefix="/buildings", tags=["parameters"])
+router = APIRouter(prefix="/buildings", tags=["parameters"], responses=ACCESS_ERRORS)
 SetId = Annotated[int, id_in_path("Parameter-set", 4)]
 
 
 @router.get(
     "/{building_id}/parameters",
-    response_model=ParameterSetList,
     summary="Every parameter set of the building, newest first, the current one marked",
-    responses=error_responses(401, 404),
 )
 def list_parameter_sets(building_id: BuildingDep, ctx: ContextDep) -> ParameterSetList:
     with ctx.db.session() as session:
@@ -34,9 +32,7 @@ def list_parameter_sets(building_id: BuildingDep, ctx: ContextDep) -> ParameterS
 
 @router.get(
     "/{building_id}/parameters/{set_id}",
-    response_model=ParameterSetRead,
     summary="One parameter set with its values, bounds and metrics",
-    responses=error_responses(401, 404),
 )
 def read_parameter_set(
     building_id: BuildingDep, set_id: SetId, ctx: ContextDep
@@ -50,7 +46,6 @@ def read_parameter_set(
     "/{building_id}/parameters/{set_id}/document",
     summary="The set as params.json, as written by `rcengine fit` and read by `rcengine predict`",
     responses={
-        **error_responses(401, 404),
         200: {
             "content": {"application/json": {"example": {"format_version": 1, "model": "basic"}}}
         },

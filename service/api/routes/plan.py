@@ -22,7 +22,6 @@ router = APIRouter(prefix="/buildings", tags=["forecast"])
 
 @router.post(
     "/{building_id}/plan",
-    response_model=PlanRead,
     summary="Heat plan of least energy (or cost) that keeps t_in in a comfort band",
     description=(
         "A linear MPC (HiGHS) over the current parameter set's discrete model, from the Kalman "
