@@ -32,7 +32,7 @@ from rcengine.estimation import PRESETS, Estimator, settings_for
 from rcengine.estimation.estimator import CRITERIA, check_criterion
 from rcengine.estimation.likelihood import LikelihoodFit
 from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
-from rcengine.forecast import forecast
+from rcengine.forecast import forecast_frame
 from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
@@ -211,8 +211,10 @@ def predict(
     def run() -> None:
         pset = ParameterSet.load(params)
         first = _instant(start, "--start", pset.building.location.timezone)
-        dataset = pset.prepare(read_timeseries(data))
-        fc = forecast(pset.compiled, pset.values, dataset, first, hours, noise=pset.noise)
+        frame = read_timeseries(data)
+        fc, _ = forecast_frame(
+            pset.compiled, pset.values, frame, pset.prepare, first, hours, noise=pset.noise
+        )
         frame = fc.to_frame(std)
         write_timeseries(frame, output, pset.building.location.timezone)
         nominal = "" if pset.noise else " (nominal: no fitted noise model)"

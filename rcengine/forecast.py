@@ -11,20 +11,27 @@ uncertainty is not included.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from rcengine.columns import Q_HVAC
+from rcengine.columns import Q_HVAC, T_IN, VENT_LOSS, WIND_LOSS
 from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.instants import parse_instant
 from rcengine.kalman import MEASUREMENT_STD_K, FilterResult, Noise, kalman_filter
 from rcengine.network import CompiledNetwork
+from rcengine.signals.derived import mask_measured
 from rcengine.statespace import DiscreteStateSpace
 
 DEFAULT_HISTORY_H = 48.0
+# Passes re-linearising a forecast's air-exchange losses at its own t_in, and the change of the
+# forecast [K] below which they stop: the loss coefficient is a small share of the envelope's
+# conductance, so each pass shrinks the change several-fold.
+LINEARISATION_PASSES = 20
+LINEARISATION_TOL_K = 1e-10
 
 
 @dataclass(frozen=True)
@@ -144,6 +151,38 @@ def forecast(
     times, u = future_inputs(data, start, steps, model.input_names)
     y, _ = model.simulate(u, filtered.state)
     return Forecast(times, y, filtered.state, model, filtered, output_std(model, filtered, steps))
+
+
+def forecast_frame(
+    network: CompiledNetwork,
+    params: dict[str, float],
+    frame: pd.DataFrame,
+    prepare: Callable[[pd.DataFrame], Dataset],
+    start: pd.Timestamp,
+    hours: float,
+    history_h: float = DEFAULT_HISTORY_H,
+    noise: Noise | None = None,
+) -> tuple[Forecast, Dataset]:
+    """``forecast`` from a contract ``frame`` (``prepare`` derives the model's inputs): the t_in
+    measured in the horizon withheld (``mask_measured``), and the inputs that depend on the indoor
+    temperature — the air-exchange losses n·ρc_pV/3600·(t_in − t_out) — linearised at the
+    forecast's own t_in, pass after pass to a fixed point. Returns the forecast and the dataset
+    of its last pass."""
+    frame = mask_measured(frame, start)
+    data = prepare(frame)
+    result = forecast(network, params, data, start, hours, history_h, noise)
+    if not set(network.input_names) & {VENT_LOSS, WIND_LOSS}:
+        return result, data
+    frame = frame.copy()
+    for _ in range(LINEARISATION_PASSES):
+        frame.loc[result.times, T_IN] = result.t_in_pred
+        data = prepare(frame)
+        latest = forecast(network, params, data, start, hours, history_h, noise)
+        moved = float(np.max(np.abs(latest.t_in_pred - result.t_in_pred), initial=0.0))
+        result = latest
+        if moved < LINEARISATION_TOL_K:
+            break
+    return result, data
 
 
 def trajectories(

@@ -20,7 +20,7 @@ from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, Problem
 from rcengine.forecast import (
     DEFAULT_HISTORY_H,
-    forecast,
+    forecast_frame,
     future_inputs,
     initial_state,
     trajectories,
@@ -30,6 +30,7 @@ from rcengine.kalman import Noise
 from rcengine.models.spec import check_future_columns
 from rcengine.network import CompiledNetwork
 from rcengine.parameter_set import ParameterSet
+from rcengine.signals import mask_measured
 from rcengine.statespace import DiscreteStateSpace
 
 from . import bridge, repository
@@ -199,7 +200,7 @@ class Forecaster:
             )
         loaded = self._loaded(building_id, key.set_id)
         _require_rows(frame, at - pd.Timedelta(hours=self.history_h), at)
-        data = loaded.pset.prepare(frame)
+        data = loaded.pset.prepare(mask_measured(frame, at))
         model = self._discrete.get_or_compute(
             (key.set_id, data.step_s),
             lambda: loaded.compiled.discrete(loaded.pset.values, data.step_s),
@@ -220,9 +221,15 @@ class Forecaster:
         _require_rows(frame, first, end)
         # Named by the columns to upload, not by the derived inputs computed from them.
         check_future_columns(frame, loaded.compiled.input_names, start, end)
-        data = loaded.pset.prepare(frame)
-        result = forecast(
-            loaded.compiled, loaded.pset.values, data, start, hours, self.history_h, loaded.noise
+        result, data = forecast_frame(
+            loaded.compiled,
+            loaded.pset.values,
+            frame,
+            loaded.pset.prepare,
+            start,
+            hours,
+            self.history_h,
+            loaded.noise,
         )
         return Prediction(
             loaded.info,

@@ -9,7 +9,7 @@ from rcengine.building import Building
 from rcengine.columns import VENT_LOSS, VENT_SCHEDULE, WIND_LOSS, schedule_signal_name
 from rcengine.exceptions import ModelError
 from rcengine.io.timeseries import read_timeseries
-from rcengine.signals.derived import SignalOptions, derive, derivers
+from rcengine.signals.derived import SignalOptions, derive, derivers, mask_measured
 from rcengine.signals.ground import ground_temperature
 from rcengine.signals.schedules import (
     clock_zone,
@@ -120,3 +120,23 @@ def test_signals_are_routed_by_name_not_prefix(project_data):
         derive(frame, building, [VENT_LOSS], SignalOptions())
     with pytest.raises(ModelError, match="needs the column 'wind_speed'"):
         derive(frame.drop(columns="wind_speed"), building, [WIND_LOSS], SignalOptions())
+
+
+def test_air_exchange_losses_run_on_the_measured_indoor_temperature(project_data):
+    """wind_loss = wind·(t_out − t_in): the measured t_in, carried over a gap and past the last
+    measurement, 20 °C before the first; a forecast's horizon is masked (``mask_measured``) so
+    its inputs cannot hold the temperature it predicts."""
+    office = project_data / "energyplus" / "office"
+    building = Building.from_json(office / "building.json")
+    frame = read_timeseries(office / "heating.csv").iloc[:6].copy()
+    frame["t_out"], frame["wind_speed"] = 0.0, 2.0
+    frame["t_in"] = [np.nan, 18.0, np.nan, 16.0, 25.0, 26.0]
+    loss = derive(frame, building, [WIND_LOSS], SignalOptions())[WIND_LOSS]
+    np.testing.assert_allclose(loss, [-40.0, -36.0, -36.0, -32.0, -50.0, -52.0])
+    masked = mask_measured(frame, frame.index[4])
+    assert masked["t_in"].iloc[:4].equals(frame["t_in"].iloc[:4])
+    assert masked["t_in"].iloc[4:].isna().all() and frame["t_in"].iloc[4:].notna().all()
+    ahead = derive(masked, building, [WIND_LOSS], SignalOptions())[WIND_LOSS]
+    np.testing.assert_allclose(ahead.iloc[3:], [-32.0, -32.0, -32.0])
+    no_sensor = derive(frame.drop(columns="t_in"), building, [WIND_LOSS], SignalOptions())
+    np.testing.assert_allclose(no_sensor[WIND_LOSS], -40.0)

@@ -20,6 +20,7 @@ from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.response import node_responses
 from rcengine.models import get_model
+from rcengine.models.physical import steady_share
 from rcengine.signals import SignalOptions, prepare
 from rcengine.signals.derived import derive
 from rcengine.signals.ground import YEAR_S, annual_cycle, seasonal_ground_temperature
@@ -106,9 +107,10 @@ CASES = {
         "glazed whole with clear glass (≤ 0.87)",
     ),
     "opaque_solar_gains": Case(
-        lambda e: dict.fromkeys(e.new_parameters, 0.6),
-        lambda e: {**dict.fromkeys(e.new_parameters, 0.6), "a_opaque_180_90": 1.6},
-        "solar absorptance of the south opaque surfaces: 1.6 exceeds any opaque surface",
+        lambda e: dict.fromkeys(e.new_parameters, 0.3),
+        lambda e: {**dict.fromkeys(e.new_parameters, 0.3), "au_opaque_180_90": 7.0},
+        "solar absorptance × U-value of the south opaque surfaces: 7 W/(m²K) exceeds any opaque "
+        "surface (α ≤ 0.95, U ≤ 6 W/(m²K))",
     ),
     "wind_infiltration": Case(
         lambda e: {"ach_wind": 0.15},
@@ -132,10 +134,10 @@ CASES = {
         "U-value of the ground floor: 3 W/(m²K) exceeds any floor (≤ 2 W/(m²K))",
     ),
     "sky_radiation": Case(
-        lambda e: {"h_sky": 4.0},
-        lambda e: {"h_sky": 11.0},
-        "long-wave coupling ε·h_r to the sky, per m² of roof + ½ wall (155 m²): 11 W/(m²K) "
-        "exceeds any envelope surface",
+        lambda e: {"u_sky": 0.5},
+        lambda e: {"u_sky": 15.0},
+        "U-value of the sky-viewing envelope, roof + ½ wall (155 m²), at ε·h_r = 4.2 W/(m²K): "
+        "15 W/(m²K) exceeds any envelope surface",
     ),
     "thermal_mass": Case(
         lambda e: {"c_mass_extra": 2e5, "r_mass_extra": 0.1},
@@ -223,17 +225,38 @@ def test_the_base_model_is_given_the_declared_glazing():
     assert with_declared_glazing(basic, unglazed, "int") is basic
 
 
-def test_opaque_sun_enters_through_the_exterior_film(gain_context):
-    """Sol-air: α·I raises the outdoor temperature by α·I·R_se, which drives α·I·R_se·G_ext/A
-    into the wall node; G_ext = 150 m² / 1.2 m²K/W over 190 m² of opaque surfaces."""
+def test_opaque_sun_reaches_the_air_as_alpha_r_se_u(gain_context):
+    """Sol-air, ISO 13790 Eq. 44: a facade's fitted α·U lets α·U·R_se of the sun on it warm the
+    room in the steady state, whatever share of the wall node's heat the fit sends outdoors."""
     ext = CANDIDATES["opaque_solar_gains"](gain_context)
-    share = 0.04 * (150.0 / 1.2) / 190.0
-    assert ext.detail["film_share"] == pytest.approx(share)
-    factors = [h.factor for h in ext.network.heat_inputs if h.gain in ext.new_parameters]
-    assert factors == pytest.approx([share] * 3)
-    reading = assess(ext, {**TRUTH_BASIC, **dict.fromkeys(ext.new_parameters, 0.9)})
-    # the steady share reaching the air stays below α·R_se·U of the darkest, poorest wall
-    assert 0.0 < reading.magnitudes["inward_share"]["value"] < 0.9 * 0.04 * 6.0
+    net, node = gain_context.network, ext.detail["node"]
+    assert ext.detail["node_share"] == pytest.approx(steady_share(net, TRUTH_BASIC, node))
+    assert 0.0 < ext.detail["node_share"] < 1.0
+    reading = assess(ext, {**TRUTH_BASIC, **dict.fromkeys(ext.new_parameters, 0.3)})
+    for key in ext.detail["orientations"]:
+        assert reading.magnitudes[f"au_{key}"]["value"] == pytest.approx(0.3)
+
+
+def test_opaque_sun_cannot_come_from_walls_conducting_more_than_the_building(gain_context):
+    """Every facade at α·U = 5 W/(m²K) needs 190 m² of walls of U ≥ 5.3 (α ≤ 0.95): 1 kW/K, ten
+    times what the whole fitted envelope loses; α·U = 1 on the smallest facade alone does not."""
+    ext = CANDIDATES["opaque_solar_gains"](gain_context)
+    dark = assess(ext, {**TRUTH_BASIC, **dict.fromkeys(ext.new_parameters, 5.0)})
+    assert any(p.startswith("conductance of the opaque surfaces") for p in dark.problems)
+    areas = {k: o["area_m2"] for k, o in ext.detail["orientations"].items()}
+    smallest = min(areas, key=areas.get)
+    one = {**dict.fromkeys(ext.new_parameters, 0.0), f"au_opaque_{smallest}": 1.0}
+    assert assess(ext, {**TRUTH_BASIC, **one}).plausible
+
+
+def test_sky_loss_cannot_come_from_a_roof_conducting_more_than_the_building(gain_context):
+    """u_sky = 8 W/(m²K) over 155 m² of roof + ½ wall is, even at the highest ε·h_r, a roof of
+    870 W/K: nine times the whole fitted envelope's loss; the fitted value is what is read."""
+    ext = CANDIDATES["sky_radiation"](gain_context)
+    poor = assess(ext, {**TRUTH_BASIC, "u_sky": 8.0})
+    assert poor.magnitudes["u_sky"]["value"] == pytest.approx(8.0)
+    assert any(p.startswith("conductance of the sky-viewing envelope") for p in poor.problems)
+    assert assess(ext, {**TRUTH_BASIC, "u_sky": 0.5}).plausible
 
 
 def test_physical_units_reach_the_network_scaled_by_the_building(gain_context):

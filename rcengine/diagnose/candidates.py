@@ -45,6 +45,7 @@ from rcengine.diagnose.plausibility import (
     G_VALUE,
     SEARCH_MARGIN,
     SKY_COUPLING,
+    SKY_H_R_TYPICAL,
     U_FLOOR,
     UNMETERED_W_M2,
     VENTILATION_ACH,
@@ -56,10 +57,11 @@ from rcengine.diagnose.response import (
     on_off_explainer,
     parameter_sensitivities,
 )
-from rcengine.models.bounds import R_SE, RHO_CP_AIR, envelope, internal_resistance
+from rcengine.models.bounds import R_SE, RHO_CP_AIR, U_OPAQUE, envelope, internal_resistance
+from rcengine.models.physical import steady_share
 from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
-from rcengine.signals.derived import T_REF_C
+from rcengine.signals.derived import indoor_operating_point
 from rcengine.signals.ground import annual_cycle, seasonal_ground_temperature
 from rcengine.signals.schedules import (
     CLOCKS,
@@ -181,45 +183,6 @@ def _facade(key: str) -> str:
     return names[int(((azimuth % 360) + 22.5) // 45) % 8]
 
 
-def _solar_by_orientation(
-    ctx: Context,
-    effect: str,
-    kind: str,
-    target: str,
-    upper: float,
-    meaning: Callable[[str, float], str],
-    factor: float = 1.0,
-) -> Extension:
-    """One gain per orientation of the building's ``kind`` surfaces ("window" or "opaque"),
-    ``factor`` × gain × ``solar_<kind>_<orientation>`` (irradiance × area [W]) into ``target``;
-    the gain is a g-value or an absorptance, searched from 0 to ``upper``."""
-    surfaces = ctx.building.windows if kind == "window" else ctx.building.walls
-    total = SOLAR_WINDOW if kind == "window" else SOLAR_OPAQUE
-    net = ctx.network.copy(_name(ctx.network, effect))
-    groups = {k: (_facade(k), a) for k, a in _areas_by_orientation(surfaces).items()}
-    params, inputs = [], []
-    for key, (facade, area) in groups.items():
-        name = f"{'g' if kind == 'window' else 'a'}_{kind}_{key}"
-        net.add_parameter(Parameter(name, "-", 0.0, upper, meaning(facade, area)))
-        signal = solar_orientation_signal(total, key)
-        net.add_heat_input(signal, target, name, factor=factor)
-        params.append(name)
-        inputs.append((signal, target))
-    detail = {
-        "orientations": {k: {"area_m2": a, "facade": f} for k, (f, a) in groups.items()},
-        "node": target,
-    }
-    return Extension(
-        effect,
-        net,
-        ctx.signals,
-        tuple(params),
-        tuple(inputs),
-        neutral=dict.fromkeys(params, 0.0),
-        detail=detail,
-    )
-
-
 def facade_areas(building: Building) -> dict[str, float]:
     """Gross area of each orientation's surfaces, glazing and opaque: the most glazing an
     orientation could have. [m²]"""
@@ -291,47 +254,53 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
     )
 
 
-def exterior_film_share(ctx: Context, node: str, area: float) -> float:
-    """R_se·G_ext/A [-]: the share of a heat flux at the outer surfaces of ``area`` [m²] that
-    the current model's exterior conductance G_ext [W/K] (``node`` to t_out) carries to ``node``.
-
-    Sol-air: the sun absorbed on a surface, α·I, raises the outdoor temperature it sees by
-    α·I·R_se (R_se = 1/h_e, ISO 6946); through the resistance A/G_ext from outdoors to ``node``
-    that drives α·I·A·R_se·G_ext/A into it. Its steady share reaching the indoor air is then
-    α·R_se·U, ISO 13790 Eq. 44. At most 1: no surface passes more than it absorbs.
-    """
-    values = [
-        r.factor * (ctx.params[r.resistance] if isinstance(r.resistance, str) else r.resistance)
-        for r in ctx.network.resistors
-        if {r.a, r.b} == {T_OUT, node}
-    ]
-    conductance = sum(1.0 / v for v in values)
-    return min(1.0, R_SE * conductance / area)
-
-
 def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
-    """Solar absorbed on the opaque walls and roof by orientation, as sol-air: absorptance α ×
-    plane-of-array irradiance × area × the exterior film share (``exterior_film_share``, from
-    the current fit), into the envelope node."""
+    """Solar absorbed on the opaque walls and roof, by orientation, as sol-air (ISO 13790
+    Eq. 44): of the irradiance I_k on the A_k m² of an orientation's opaque surfaces,
+    α_k·R_se·U_k·A_k·I_k reaches the indoor air in the steady state.
+
+    The quantity fitted per orientation is the product α·U [W/(m²K)]: the description gives
+    neither the surfaces' colour nor their U-value, and the lumped wall node's conductance is the
+    envelope's average, not the sunlit facade's (a dark, uninsulated facade over a well insulated
+    roof). The sun ``solar_opaque_<k>`` (A_k × plane-of-array irradiance [W]) enters the envelope
+    node, scaled by R_se over the share of that node's heat that warms the room under the current
+    fit (``steady_share``), so that its steady share is α·U·R_se.
+    """
     effect = "opaque_solar_gains"
     if not ctx.building.walls:
         return Skipped(effect, "no opaque walls ('walls') in the building JSON")
     if _has_signal(ctx.network, SOLAR_OPAQUE):
         return Skipped(effect, "the model already has opaque solar gains")
     node = envelope_node(ctx.network)
-    share = exterior_film_share(ctx, node, sum(w.area for w in ctx.building.walls))
-    if share == 0.0:
-        return Skipped(effect, f"no resistance from outdoors to '{node}' for sol-air to act on")
-    ext = _solar_by_orientation(
-        ctx,
+    share = steady_share(ctx.network, ctx.params, node)
+    if share <= 0.0:
+        return Skipped(effect, f"no heat at '{node}' reaches the indoor air for sol-air to act on")
+    net = ctx.network.copy(_name(ctx.network, effect))
+    groups = {k: (_facade(k), a) for k, a in _areas_by_orientation(ctx.building.walls).items()}
+    upper = SEARCH_MARGIN * ABSORPTANCE[1] * U_OPAQUE[1]
+    params, inputs = [], []
+    for key, (facade, area) in groups.items():
+        name = f"au_opaque_{key}"
+        meaning = f"solar absorptance × U-value of the {facade} opaque surfaces ({area:g} m²)"
+        net.add_parameter(Parameter(name, "W/(m²K)", 0.0, upper, meaning))
+        signal = solar_orientation_signal(SOLAR_OPAQUE, key)
+        net.add_heat_input(signal, node, name, factor=R_SE / share)
+        params.append(name)
+        inputs.append((signal, node))
+    detail = {
+        "orientations": {k: {"area_m2": a, "facade": f} for k, (f, a) in groups.items()},
+        "node": node,
+        "node_share": share,
+    }
+    return Extension(
         effect,
-        "opaque",
-        node,
-        SEARCH_MARGIN * ABSORPTANCE[1],
-        lambda facade, area: f"solar absorptance of the {facade} opaque surfaces ({area:g} m²)",
-        share,
+        net,
+        ctx.signals,
+        tuple(params),
+        tuple(inputs),
+        neutral=dict.fromkeys(params, 0.0),
+        detail=detail,
     )
-    return replace(ext, detail={**ext.detail, "film_share": share})
 
 
 def _with_gain(
@@ -375,7 +344,8 @@ def _air_change_loss(
 
 def wind_infiltration(ctx: Context) -> Extension | Skipped:
     """Air leakage growing with wind speed, in air changes per hour per m/s through the volume:
-    loss = n_wind · ρc_pV/3600 · wind · (T_REF − t_out)."""
+    loss = n_wind · ρc_pV/3600 · wind · (t_in − t_out), t_in the measured indoor temperature
+    (``signals.derived.indoor_operating_point``)."""
     effect = "wind_infiltration"
     if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
         return Skipped(effect, "no wind_speed column in the data")
@@ -385,7 +355,7 @@ def wind_infiltration(ctx: Context) -> Extension | Skipped:
         "ach_wind",
         "1/h per m/s",
         WIND_ACH_PER_M_S[1],
-        f"air changes per hour per m/s of wind: loss = n·ρc_pV/3600·wind·({T_REF_C:g} °C − t_out)",
+        "air changes per hour per m/s of wind: loss = n·ρc_pV/3600·wind·(t_in − t_out)",
         WIND_LOSS,
     )
 
@@ -534,16 +504,13 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     effect = "ventilation_schedule"
     if VENT_LOSS in ctx.network.signals:
         return Skipped(effect, "the model already has a ventilation schedule")
-    outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - T_REF_C
+    outdoor_excess = ctx.train[T_OUT].to_numpy(dtype=float) - indoor_operating_point(ctx.train)
     # A missing loss may itself drive the heater to its capacity: those rows are evidence.
     saturated = np.zeros(len(ctx.data), dtype=bool)
     learnt = _learnt_schedule(ctx, ctx.network.output, outdoor_excess, saturated)
     if not learnt.schedule.any():
         return Skipped(effect, "the residuals show no weekly pattern of extra heat loss")
-    meaning = (
-        f"air changes per hour in the scheduled hours (loss = n·ρc_pV/3600·({T_REF_C:g} °C − "
-        "t_out))"
-    )
+    meaning = "air changes per hour in the scheduled hours (loss = n·ρc_pV/3600·(t_in − t_out))"
     ext = _air_change_loss(ctx, effect, "ach_vent", "1/h", VENTILATION_ACH[1], meaning, VENT_LOSS)
     return _on_schedule(ext, VENT_SCHEDULE, learnt)
 
@@ -640,29 +607,34 @@ def sky_view_area(building: Building) -> float:
 
 def sky_radiation(ctx: Context) -> Extension | Skipped:
     """Long-wave loss of the envelope to the (cold, clear, night) sky, as sol-air in the
-    long-wave: q = h_sky·F·A·(T_sky − t_out) at the outer surfaces (h_sky ≈ ε·4σT³ per m² of
-    sky-viewing area, ``sky_view_area``) reaching the envelope node by the exterior film share
-    (``exterior_film_share``)."""
+    long-wave: the sky lowers the temperature the outer surfaces see by ε·h_r·R_se·(T_sky −
+    t_out), and U·R_se·ε·h_r·A·(T_sky − t_out) of it reaches the room in the steady state (A:
+    the sky-viewing area, ``sky_view_area``).
+
+    The quantity fitted is u_sky, the U-value of the sky-viewing envelope, at ε·h_r =
+    ``SKY_H_R_TYPICAL`` (the lumped wall's conductance is the envelope's average, not the roof's:
+    an uninsulated roof over insulated walls). ``sky_delta`` enters the envelope node, scaled
+    by R_se over the share of that node's heat that warms the room under the current fit
+    (``steady_share``)."""
     effect = "sky_radiation"
     if SKY_DELTA in ctx.network.signals:
         return Skipped(effect, "the model already has sky radiation")
     target = envelope_node(ctx.network)
-    building = ctx.building
-    opaque = sum(s.area for s in building.walls) or building.wall_area + building.floor_area
-    view = sky_view_area(building)
-    h_sky = Parameter(
-        "h_sky",
+    view = sky_view_area(ctx.building)
+    share = steady_share(ctx.network, ctx.params, target)
+    if share <= 0.0:
+        return Skipped(effect, f"no heat at '{target}' reaches the indoor air for the sky to cool")
+    u_sky = Parameter(
+        "u_sky",
         "W/(m²K)",
         0.0,
-        SEARCH_MARGIN * SKY_COUPLING[1],
-        f"long-wave coupling ε·h_r of the envelope to the sky, per m² of roof + ½ wall ({view:g} "
-        "m²)",
+        SEARCH_MARGIN * U_OPAQUE[1] * SKY_COUPLING[1] / SKY_H_R_TYPICAL,
+        f"U-value of the sky-viewing envelope, roof + ½ wall ({view:g} m²), at ε·h_r = "
+        f"{SKY_H_R_TYPICAL:.2g} W/(m²K)",
     )
-    share = exterior_film_share(ctx, target, opaque)
-    if share == 0.0:
-        return Skipped(effect, f"no resistance from outdoors to '{target}' for the sky to act on")
-    detail = {"node": target, "sky_view_area_m2": view, "film_share": share}
-    return _with_gain(ctx, effect, h_sky, (SKY_DELTA, target), detail, share * view)
+    detail = {"node": target, "sky_view_area_m2": view, "node_share": share}
+    factor = SKY_H_R_TYPICAL * R_SE * view / share
+    return _with_gain(ctx, effect, u_sky, (SKY_DELTA, target), detail, factor)
 
 
 def thermal_mass(ctx: Context) -> Extension | Skipped:

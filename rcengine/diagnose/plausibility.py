@@ -20,15 +20,22 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from rcengine.columns import Q_HVAC, SOLAR_OPAQUE, SOLAR_WINDOW, solar_orientation_signal
+from rcengine.columns import (
+    Q_HVAC,
+    SKY_DELTA,
+    SOLAR_OPAQUE,
+    SOLAR_WINDOW,
+    solar_orientation_signal,
+)
 from rcengine.models.bounds import (
     ABSORPTANCE_MAX,
     G_GLAZING_MAX,
     KAPPA_INTERNAL,
+    R_SE,
     U_GROUND_MAX,
-    opaque_solar_share_max,
+    U_OPAQUE,
 )
-from rcengine.models.physical import solar_apertures
+from rcengine.models.physical import solar_apertures, steady_state_gains, ua
 
 if TYPE_CHECKING:
     from rcengine.diagnose.candidates import Extension
@@ -66,6 +73,9 @@ SKY_COUPLING: Range = (
     0.1 * 4 * STEFAN_BOLTZMANN * 253.15**3,
     0.95 * 4 * STEFAN_BOLTZMANN * 303.15**3,
 )
+# ε·h_r of a painted, brick or roofing surface (ε = 0.9) at 0 °C, the coupling at which the sky
+# candidate reads its fitted loss as a U-value. [W/(m²K)]
+SKY_H_R_TYPICAL = 0.9 * 4 * STEFAN_BOLTZMANN * 273.15**3
 # Storage the model lacks, per m² of floor: the base models' internal-mass range (10–1000 kJ).
 EXTRA_CAPACITY_J_M2K: Range = KAPPA_INTERNAL
 # Emitter time constant: a fan coil or convector (minutes) to a screeded underfloor system
@@ -126,35 +136,6 @@ def assess(ext: Extension, params: Mapping[str, float]) -> Assessment:
     return Assessment({r.key: r.as_dict() for r in readings}, problems)
 
 
-def _area_mean(values: Mapping[str, float], areas: Mapping[str, float]) -> float:
-    return sum(values[k] * areas[k] for k in values) / sum(areas[k] for k in values)
-
-
-def _by_orientation(
-    ext: Extension, values: Mapping[str, float], name: str, what: tuple[str, str], full: Range
-) -> list[Reading]:
-    """One reading per orientation ``{key: value}``, at most the top of ``full`` (a weakly lit
-    facade's fit is loose below it), and their area-weighted mean within ``full``; ``what`` is
-    (the quantity, the surfaces): ("implied g-value", "glazing")."""
-    orientations = ext.detail["orientations"]
-    quantity, surfaces = what
-    of = surfaces.removesuffix("s")
-    readings = [
-        Reading(
-            f"{name}_{k}",
-            value,
-            "-",
-            f"{quantity} of the {orientations[k]['facade']} {surfaces}",
-            (0.0, full[1]),
-            of,
-        )
-        for k, value in values.items()
-    ]
-    areas = {k: v["area_m2"] for k, v in orientations.items()}
-    mean = _area_mean(values, areas)
-    return [*readings, Reading(f"{name}_mean", mean, "-", f"area-weighted {quantity}", full, of)]
-
-
 def _declared_g(ext: Extension, params: Mapping[str, float]) -> float:
     """The declared glazing's g-value in the fitted model: its steady aperture (the share of the
     transmitted sun reaching the air), else the sum of its gains when ``params`` is partial."""
@@ -191,25 +172,40 @@ def _window(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 
 def _opaque(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Absorptance per orientation (at most the darkest surface's), their area-weighted mean, and
-    the steady share of the sun on the walls that reaches the indoor air, at most α·R_se·U of the
-    darkest, least insulated wall (ISO 13790 Eq. 44)."""
+    """Per orientation the fitted α·U (steady share reaching the air over R_se, ISO 13790 Eq. 44),
+    at most that of the darkest surface on the poorest wall; and the conductance those facades
+    must have, Σ A_k·(α·U)_k / α_max (each at least as dark as the darkest paint allows), which
+    cannot exceed the whole fitted envelope's UA: a facade cannot let in the sun of a wall that
+    conducts more heat than the building loses."""
     orientations = ext.detail["orientations"]
-    alpha = {k: params[f"a_opaque_{k}"] for k in orientations}
-    what = ("solar absorptance", "opaque surfaces")
-    readings = _by_orientation(ext, alpha, "absorptance", what, ABSORPTANCE)
-    if set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals:
+    au = {k: params[f"au_opaque_{k}"] for k in orientations}
+    complete = set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals
+    if complete:
         apertures = solar_apertures(ext.network, dict(params))
-        shares = {k: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] for k in orientations}
-        areas = {k: v["area_m2"] for k, v in orientations.items()}
+        au = {k: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] / R_SE for k in au}
+    most = ABSORPTANCE[1] * U_OPAQUE[1]
+    readings = [
+        Reading(
+            f"au_{k}",
+            value,
+            "W/(m²K)",
+            f"solar absorptance × U-value of the {orientations[k]['facade']} opaque surfaces",
+            (0.0, most),
+            f"opaque surface (α ≤ {ABSORPTANCE[1]:g}, U ≤ {U_OPAQUE[1]:g} W/(m²K))",
+        )
+        for k, value in au.items()
+    ]
+    if complete:
+        implied = sum(au[k] * o["area_m2"] for k, o in orientations.items()) / ABSORPTANCE[1]
+        loss = ua(ext.network, dict(params))
         readings.append(
             Reading(
-                "inward_share",
-                _area_mean(shares, areas),
-                "-",
-                "share of the sun on the opaque surfaces reaching the indoor air",
-                (0.0, opaque_solar_share_max()),
-                "wall (α·R_se·U)",
+                "ua_sunlit",
+                implied,
+                "W/K",
+                "conductance of the opaque surfaces their sun implies, Σ A·(α·U)/α_max",
+                (0.0, loss),
+                f"building with the fitted heat-loss coefficient ({loss:.0f} W/K)",
             )
         )
     return readings
@@ -267,17 +263,42 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 
 def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    """The sky-viewing envelope's U-value at ε·h_r = ``SKY_H_R_TYPICAL`` (the steady share
+    reached, read from the fitted network), at most the poorest wall's at the highest coupling;
+    and the conductance of the sky-viewing area it implies at that highest coupling, which cannot
+    exceed the whole fitted envelope's UA."""
     area = ext.detail["sky_view_area_m2"]
-    return [
+    u_sky = params["u_sky"]
+    complete = set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals
+    if complete:
+        gains = steady_state_gains(ext.network, dict(params))
+        u_sky = gains[SKY_DELTA] / gains[Q_HVAC] / (SKY_H_R_TYPICAL * R_SE * area)
+    least = SKY_H_R_TYPICAL / SKY_COUPLING[1]  # U at the highest coupling, per u_sky
+    readings = [
         Reading(
-            "sky_coupling",
-            params["h_sky"],
+            "u_sky",
+            u_sky,
             "W/(m²K)",
-            f"long-wave coupling ε·h_r to the sky, per m² of roof + ½ wall ({area:g} m²)",
-            SKY_COUPLING,
-            "envelope surface (ε·4σT³)",
+            f"U-value of the sky-viewing envelope, roof + ½ wall ({area:g} m²), at ε·h_r = "
+            f"{SKY_H_R_TYPICAL:.2g} W/(m²K)",
+            (0.0, U_OPAQUE[1] / least),
+            "envelope surface",
         )
     ]
+    if complete:
+        loss = ua(ext.network, dict(params))
+        readings.append(
+            Reading(
+                "ua_sky",
+                area * u_sky * least,
+                "W/K",
+                "conductance of the sky-viewing envelope its sky loss implies (at the highest "
+                "ε·h_r)",
+                (0.0, loss),
+                f"building with the fitted heat-loss coefficient ({loss:.0f} W/K)",
+            )
+        )
+    return readings
 
 
 def _mass(ext: Extension, params: Mapping[str, float]) -> list[Reading]:

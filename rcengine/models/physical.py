@@ -45,6 +45,17 @@ def steady_state_gains(
     return dict(zip(net.input_names, gains.tolist(), strict=True))
 
 
+def steady_share(network: RCNetwork, params: dict[str, float], node: str) -> float:
+    """Settled indoor temperature rise per W held at ``node`` over that per W held in the indoor
+    air: the share of a heat flow at ``node`` that warms the room rather than leaving through the
+    node's own paths outdoors. [-]"""
+    probe = network.copy("probe")
+    probe.add_heat_input("probe_node", node)
+    probe.add_heat_input("probe_air", network.output)
+    gains = steady_state_gains(probe, params)
+    return gains["probe_node"] / gains["probe_air"]
+
+
 def ua(network: RCNetwork | CompiledNetwork, params: dict[str, float]) -> float:
     """Heat-loss coefficient: heat holding the indoor air 1 K above its boundaries. [W/K]"""
     gains = steady_state_gains(network, params)

@@ -4,6 +4,6 @@
 simulates.
 """
 
-from rcengine.signals.derived import SignalOptions, derive, prepare
+from rcengine.signals.derived import SignalOptions, derive, mask_measured, prepare
 
-__all__ = ["SignalOptions", "derive", "prepare"]
+__all__ = ["SignalOptions", "derive", "mask_measured", "prepare"]

@@ -18,6 +18,7 @@ from rcengine.columns import (
     NUMERIC_COLUMNS,
     SKY_DELTA,
     T_GROUND,
+    T_IN,
     T_OUT,
     UNIT,
     VENT_LOSS,
@@ -32,8 +33,8 @@ from rcengine.signals.ground import AnnualCycle, seasonal_ground_temperature
 from rcengine.signals.schedules import Zone, clock_zone, schedule_signal
 from rcengine.signals.solar import solar_gains, solar_signal_names
 
-# Indoor reference of the air-exchange loss signals: loss ∝ rate × (T_REF − t_out). [°C]
-# The true indoor temperature varies by a few kelvin around it; the fitted gain absorbs the mean.
+# Indoor temperature of the air-exchange losses where none was measured before (and none after):
+# a heated building's usual setpoint. [°C]
 T_REF_C = 20.0
 
 
@@ -85,22 +86,48 @@ def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
     return frame[column].to_numpy(dtype=float)
 
 
+def indoor_operating_point(frame: pd.DataFrame) -> np.ndarray:
+    """The indoor temperature an air-exchange loss n·ρc_pV/3600·(t_in − t_out) is linearised at:
+    the measured ``t_in``, carried forward over gaps and past the last measurement (a forecast's
+    horizon, which must hold none: ``mask_measured``), ``T_REF_C`` before the first. [°C]
+
+    The loss is bilinear (rate × indoor temperature). A fixed reference instead of t_in
+    overstates it wherever the room runs cold — a heater at its capacity, a setback — and makes
+    a scheduled loss almost a constant plus a t_out term, which other physics can mimic.
+    """
+    if T_IN not in frame.columns:
+        return np.full(len(frame), T_REF_C)
+    return frame[T_IN].astype(float).ffill().fillna(T_REF_C).to_numpy()
+
+
+def mask_measured(frame: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
+    """``frame`` without the ``t_in`` measured from ``start`` on: what a forecast from ``start``
+    may not see, even through a derived input (``indoor_operating_point``)."""
+    if T_IN not in frame.columns or not (frame.index >= start).any():
+        return frame
+    masked = frame.copy()
+    masked.loc[masked.index >= start, T_IN] = np.nan
+    return masked
+
+
 def _wind_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """wind_loss = wind_speed · (t_out − T_REF). [m/s·K]"""
+    """wind_loss = wind_speed · (t_out − t_in) (``indoor_operating_point``). [m/s·K]"""
     t_out = frame[T_OUT].to_numpy(dtype=float)
     wind = _require(frame, WIND_SPEED, WIND_LOSS)
-    return pd.DataFrame({WIND_LOSS: wind * (t_out - T_REF_C)}, index=frame.index)
+    loss = wind * (t_out - indoor_operating_point(frame))
+    return pd.DataFrame({WIND_LOSS: loss}, index=frame.index)
 
 
 def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """vent_loss = vent schedule · (t_out − T_REF). [K]"""
+    """vent_loss = vent schedule · (t_out − t_in) (``indoor_operating_point``). [K]"""
     if VENT_SCHEDULE not in options.schedules:
         raise ModelError(f"signal '{VENT_LOSS}' needs a '{VENT_SCHEDULE}' schedule")
     t_out = frame[T_OUT].to_numpy(dtype=float)
     schedule = schedule_signal(
         options.schedules[VENT_SCHEDULE], frame.index, options.schedule_zone(building)
     )
-    return pd.DataFrame({VENT_LOSS: schedule * (t_out - T_REF_C)}, index=frame.index)
+    loss = schedule * (t_out - indoor_operating_point(frame))
+    return pd.DataFrame({VENT_LOSS: loss}, index=frame.index)
 
 
 def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:

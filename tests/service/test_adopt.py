@@ -11,7 +11,6 @@ through the service on the EnergyPlus variants, in tests/service/test_adopt_vari
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pandas as pd
@@ -66,16 +65,17 @@ def truth() -> pd.DataFrame:
     rng = np.random.default_rng(4)
     frame["wind_speed"] = np.repeat(rng.uniform(0.0, 9.0, 5 * 8), 12)  # 3-hourly gusts [m/s]
     compiled = wind_network().compile()
-    data = prepare(frame, BUILDING, compiled.input_names)
     rc = compiled.rc_matrices({**TRUTH_BASIC, "ach_wind": ACH_WIND})
-    u = data.inputs(compiled.input_names)
-    frame["t_in"] = simulate(rc, u, np.full((1, 3), 19.0), data.step_s)[0]
+    # The leakage loss is bilinear, wind·(t_in − t_out): iterated to its fixed point, each pass
+    # linearised at the previous pass's indoor temperature (the signal reads the frame's t_in).
+    for _ in range(8):
+        data = prepare(frame, BUILDING, compiled.input_names)
+        u = data.inputs(compiled.input_names)
+        frame["t_in"] = simulate(rc, u, np.full((1, 3), 19.0), data.step_s)[0]
     return frame
 
 
-@pytest.fixture(scope="module")
-def client(tmp_path_factory) -> Iterator[TestClient]:
-    yield from module_client(tmp_path_factory, "adopt", preset="modestpy", training_days=3)
+client = module_client("adopt", preset="modestpy", training_days=3)
 
 
 def fake_report(accepted: bool = True, lowest: float = 0.0) -> dict:
@@ -197,7 +197,8 @@ def test_model_and_simulate_of_an_adopted_model_match_the_forecast(client, adopt
     set_id = served["parameter_set"]["id"]
     document = client.get(f"/buildings/{building_id}/parameters/{set_id}/document", headers=headers)
     pset = ParameterSet.from_dict(document.json())
-    future = truth.iloc[4 * DAY : 4 * DAY + 48].drop(columns="t_in")
+    # The leakage is linearised at the forecast's own indoor temperature (forecast_frame).
+    future = truth.iloc[4 * DAY : 4 * DAY + 48].assign(t_in=served["t_in_pred"])
     u = pset.prepare(future).inputs(tuple(m["input_names"]))
     A, B, C, D = (np.array(m[k]) for k in ("A", "B", "C", "D"))
     x, outputs = np.array(m["state"]["x"]), []
@@ -346,14 +347,7 @@ def test_auto_adopt_adopts_a_diagnosis_with_findings_and_calibrates(tmp_path, tr
 @pytest.mark.slow
 def test_the_documented_adopt_session_runs_against_a_live_server(tmp_path):
     """docs/service.md's adopt flow, run as written (the docs' first session: test_docs_session)."""
-    run, log = run_docs_session(
-        tmp_path,
-        "The adopt flow with `curl`",
-        RCSERVICE_DIAGNOSIS_PRESET="modestpy",
-        RCSERVICE_PRESET="modestpy",
-    )
-    assert run.returncode == 0, f"{run.stdout[-3000:]}\n{run.stderr[-2000:]}\n{log}"
-    out = run.stdout
+    out = run_docs_session(tmp_path, "The adopt flow with `curl`", RCSERVICE_PRESET="modestpy")
     assert "missing" in out and "wind_infiltration" in out, out
     assert '"changed":true' in out and "'name': 'basic+wind_infiltration'" in out, out
     assert '"parameter_set":{"id":2,' in out and '"model":"basic+wind_infiltration"' in out, out
