@@ -22,6 +22,7 @@ from rcengine.estimation import Estimator
 from rcengine.estimation.likelihood import (
     LikelihoodObjective,
     LikelihoodSpace,
+    discretize_modal,
     likelihood_ratio_test,
 )
 from rcengine.estimation.residuals import residual_checks
@@ -83,9 +84,11 @@ def excitation(days: int, seed: int = 5) -> pd.DataFrame:
     rng = np.random.default_rng(seed)
     times = pd.date_range("2017-01-09", periods=days * 48, freq="30min", tz="UTC")
     hours = np.arange(times.size) * 0.5
-    t_out = 5.0 + 4.0 * np.sin((hours - 9.0) / 24 * 2 * np.pi) + rng.normal(0, 1.0, days)[
-        np.arange(times.size) // 48
-    ]
+    t_out = (
+        5.0
+        + 4.0 * np.sin((hours - 9.0) / 24 * 2 * np.pi)
+        + rng.normal(0, 1.0, days)[np.arange(times.size) // 48]
+    )
     q_hvac = 3000.0 * np.repeat(rng.integers(0, 2, times.size // 4 + 1), 4)[: times.size]
     return pd.DataFrame({"t_out": t_out, "ghi": 0.0, "q_hvac": q_hvac}, index=times)
 
@@ -150,6 +153,26 @@ def test_van_loan_matches_quadrature_also_when_stiff(stiffness):
     np.testing.assert_allclose(Q_d, ref_Q, rtol=1e-7, atol=1e-12)
     assert np.linalg.eigvalsh(Q_d).min() > 0
     np.testing.assert_allclose(A_d, discretize(A, B, STEP_S)[0], atol=1e-12)
+
+
+@pytest.mark.parametrize("stiffness", [1.0, 400.0, 1e4])
+def test_modal_discretisation_matches_quadrature_also_when_stiff(stiffness):
+    """The likelihood's discretisation through the modes of the library's 2r2c: the fast air
+    mode's noise counts even where its decay underflows (‖A‖dt ≈ 2,500 at 10⁴)."""
+    params = {**TRUTH, "c_air": TRUTH["c_air"] / stiffness}
+    A, B = reference_matrices(params)
+    process_std = np.array([[0.2, 0.05]])
+    ref_A, ref_B, ref_Q = quadrature_discretisation(
+        A, B, np.diag(process_std[0] ** 2) / 3600.0, STEP_S
+    )
+    net = network()
+    A_d, B_d, Q_d, valid = discretize_modal(
+        net.rc_matrices(net.as_theta({**params, **NO_SUN})), process_std, STEP_S
+    )
+    assert valid.all()
+    np.testing.assert_allclose(A_d[0], ref_A, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(B_d[0], ref_B, rtol=1e-8, atol=1e-14)
+    np.testing.assert_allclose(Q_d[0], ref_Q, rtol=1e-7, atol=1e-12)
 
 
 def test_constant_gain_rows_equal_the_plain_recursion(monkeypatch):

@@ -5,9 +5,10 @@ held over each step),
 
     dx = (A x + B u) dt + diag(σ_w) dω,        y[k] = C x[k] + D u[k] + v[k],  v ~ N(0, σ_v²).
 
-Exact discretisation (``statespace``): x[k+1] = A_d x[k] + B_d u[k] + w[k], w ~ N(0, Q_d), with
-Q_d = ∫₀^dt e^{Aτ} Σ e^{Aᵀτ} dτ by Van Loan's method. Under the model the Kalman filter's
-innovations e[k] are independent N(0, s[k]), so (Schweppe 1965)
+Exact discretisation: x[k+1] = A_d x[k] + B_d u[k] + w[k], w ~ N(0, Q_d), with
+Q_d = ∫₀^dt e^{Aτ} Σ e^{Aᵀτ} dτ, here through the network's modes (:func:`discretize_modal`;
+equal to Van Loan's ``statespace.discretize_stochastic`` to round-off, and cheaper). Under the
+model the Kalman filter's innovations e[k] are independent N(0, s[k]), so (Schweppe 1965)
 
     −ln L(θ) = ½ Σ_k [ ln(2π s[k]) + e[k]² / s[k] ].
 
@@ -28,13 +29,15 @@ as the output-error fit does (unbounded, the likelihood can prefer an unphysical
 wall of near-infinite capacity with large noise): it runs in ξ, the logit of each physical z's
 position between its bounds (noise coordinates unchanged). One batched filter screens a Latin
 hypercube (the GA's first generation; more generations are a setting), each point scored at its
-best overall noise level; from the best distinct points scipy's ``trust-exact`` minimises −ln L
-over ξ with the gradient by central differences and the Hessian by Fisher scoring,
+best overall noise level; from the best distinct points a trust-region method (Nocedal & Wright
+2006, Algorithm 4.1, the exact step of Moré & Sorensen) minimises −ln L over ξ with the gradient
+by central differences and the Hessian by Fisher scoring,
 
     I(ξ) ≈ Σ_k [ ∂e ∂eᵀ / s + ½ ∂ln s ∂ln sᵀ ],
 
-both from one filter batched over the 2q + 1 perturbed parameter sets. Standard errors come from
-the observed information, a finite-difference Hessian of −ln L at the optimum (one more batch).
+all starts in lockstep: each iteration runs one filter batched over the 2q + 1 perturbed sets of
+every running start's trial point. Standard errors come from the observed information, a
+finite-difference Hessian of −ln L at the optimum (one more batch).
 """
 
 from __future__ import annotations
@@ -42,7 +45,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 import scipy.special
 from scipy.stats import chi2
 
@@ -53,8 +55,8 @@ from rcengine.estimation.residuals import ResidualChecks, residual_checks
 from rcengine.estimation.search_space import SearchSpace
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.kalman import S_PER_H, Noise, filter_batch
-from rcengine.network import CompiledNetwork
-from rcengine.statespace import discretize_stochastic
+from rcengine.network import CompiledNetwork, RCMatrices
+from rcengine.simulate import modal_system
 
 INITIAL = ("diffuse", "estimated")
 # Central-difference steps in z. The filter's −ln L carries ~1e-11 of round-off: the gradient is
@@ -73,6 +75,12 @@ IDENTIFIABLE_SPAN = 10.0
 Z_95 = 1.96
 # Accepted steps over which −ln L must fall by ftol for a local search to go on.
 _PATIENCE = 3
+# Trust region in ξ: the first radius, its limits, and the least ratio of actual to promised
+# decrease for a step to be taken (the values of scipy's trust-region methods).
+_INITIAL_RADIUS, _MAX_RADIUS, _MIN_RADIUS = 1.0, 1000.0, 1e-10
+_ACCEPT = 0.15
+# Newton iterations for the trust-region multiplier (converges from below, in a few).
+_SECULAR_STEPS = 8
 # Relative ridge on M, so a segment too short to see every initial state stays solvable.
 _RIDGE = 1e-10
 
@@ -143,6 +151,13 @@ class LikelihoodSpace:
         """Free parameter values (…, f) → their z coordinates."""
         return np.where(self.positive, np.log(np.maximum(free, self._floor)), free / self.scale)
 
+    @property
+    def widths(self) -> np.ndarray:
+        """(q,) the width in z of each coordinate's range: the model's bounds, then the noise
+        screening ranges."""
+        noise = [PROCESS_STD_RANGE] * len(self.state_names) + [MEASUREMENT_STD_RANGE]
+        return np.concatenate([self._upper - self._lower, np.log([hi / lo for lo, hi in noise])])
+
     def from_unit(self, unit: np.ndarray) -> np.ndarray:
         """Unit-cube points (S, q) — the model's bounds, then the noise screening ranges — → z."""
         unit = np.atleast_2d(unit)
@@ -196,6 +211,34 @@ class Evaluation:
         )
 
 
+def discretize_modal(
+    rc: RCMatrices, process_std: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A_d, B_d, Q_d as :func:`rcengine.statespace.discretize_stochastic` gives them, and which
+    sets are valid, from the modes of the RC systems (:func:`rcengine.simulate.modal_system`).
+
+    With z = W T the modes decouple (rates λ_i, a_i = e^{−λ_i dt}); a noise of intensity
+    Σ_z = W Σ Wᵀ, Σ = diag(σ_w²)/3600, gathers (Σ_z)_ij (1 − a_i a_j)/(λ_i + λ_j) over one step.
+    No exponential of a stiff matrix, and ~5× cheaper than Van Loan's. process_std (S, n)
+    [K/√h]; dt [s]. Invalid sets (not finite, not passive) get a harmless stand-in system.
+    """
+    modes = modal_system(rc, dt)
+    W = modes.to_modal
+    capacity = np.where(modes.valid[:, None], rc.capacity, 1.0)
+    to_nodes = np.swapaxes(W / capacity[:, None, :], 1, 2)  # W⁻¹ = C^{-1/2} Q
+    # λ_i from the transform itself (the decays underflow for fast modes, whose noise counts).
+    conductance = np.where(modes.valid[:, None, None], rc.K, 0.0) / capacity[:, :, None]
+    rate = np.maximum(np.einsum("sij,sjk,ski->si", W, conductance, to_nodes), 0.0)
+    pair = rate[:, :, None] + rate[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gathered = np.where(pair * dt > 1e-12, -np.expm1(-pair * dt) / pair, dt)
+    sigma_z = (W * (process_std**2 / S_PER_H)[:, None, :]) @ np.swapaxes(W, 1, 2)
+    Q = to_nodes @ (sigma_z * gathered) @ np.swapaxes(to_nodes, 1, 2)
+    A_d = (to_nodes * modes.decay[:, None, :]) @ W
+    B_d = to_nodes @ modes.input_map
+    return A_d, B_d, 0.5 * (Q + np.swapaxes(Q, 1, 2)), modes.valid
+
+
 class LikelihoodObjective:
     """−ln L of parameter sets z (S, q) on ``data``, every segment from its own initial state."""
 
@@ -220,23 +263,13 @@ class LikelihoodObjective:
     def __call__(self, z: np.ndarray) -> Evaluation:
         theta, process_std, measurement_std = self.space.split(z)
         self.n_evaluations += theta.shape[0]
-        A, B, C, D = self.network.state_space(theta)
-        valid = (
-            np.isfinite(A).all((1, 2))
-            & np.isfinite(B).all((1, 2))
-            & np.isfinite(C).all(1)
-            & np.isfinite(D).all(1)
-        )
-        n = A.shape[1]
-        A = np.where(valid[:, None, None], A, -np.eye(n))
-        B = np.where(valid[:, None, None], B, 0.0)
-        C, D = np.where(valid[:, None], C, 0.0), np.where(valid[:, None], D, 0.0)
-        diffusion = process_std[:, :, None] * np.eye(n) * process_std[:, None, :] / S_PER_H
-        A_d, B_d, Q = discretize_stochastic(A, B, diffusion, self.step_s)
+        rc = self.network.rc_matrices(theta)
+        A_d, B_d, Q, valid = discretize_modal(rc, process_std, self.step_s)
+        n = A_d.shape[1]
+        C, D = np.where(valid[:, None], rc.c, 0.0), np.where(valid[:, None], rc.d, 0.0)
         P0 = Q if self.initial == "estimated" else np.zeros_like(Q)
         parts = [
-            self._segment(A_d, B_d, C, D, Q, measurement_std**2, P0, u, y)
-            for u, y in self.segments
+            self._segment(A_d, B_d, C, D, Q, measurement_std**2, P0, u, y) for u, y in self.segments
         ]
         nll = np.sum([p[0] for p in parts], axis=0)
         nll = np.where(valid & np.isfinite(nll), nll, np.inf)
@@ -274,63 +307,131 @@ class LikelihoodObjective:
 
 def derivatives(
     objective: LikelihoodObjective, xi: np.ndarray, step: float = GRADIENT_STEP
-) -> tuple[float, np.ndarray, np.ndarray]:
-    """−ln L, its gradient (central differences) and the Fisher-scoring Hessian at ξ (q,)."""
-    q = xi.size
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """−ln L (m,), its gradient (m, q) by central differences and the Fisher-scoring Hessian
+    (m, q, q) at the points ξ (m, q), all m stencils of 2q + 1 sets in one batched filter."""
+    m, q = xi.shape
     shifts = step * np.eye(q)
-    ev = objective(objective.space.from_search(np.vstack([xi, xi + shifts, xi - shifts])))
-    if not np.isfinite(ev.nll[0]):
-        return np.inf, np.zeros(q), np.eye(q)
+    stencil = np.concatenate([xi[:, None], xi[:, None] + shifts, xi[:, None] - shifts], axis=1)
+    ev = objective(objective.space.from_search(stencil.reshape(-1, q)))
+    nll = ev.nll.reshape(m, 2 * q + 1)
+    e = ev.innovations.reshape(m, 2 * q + 1, -1)
+    log_s = np.log(ev.variances.reshape(m, 2 * q + 1, -1))
     plus, minus = slice(1, q + 1), slice(q + 1, None)
-    gradient = (ev.nll[plus] - ev.nll[minus]) / (2 * step)
-    d_e = (ev.innovations[plus] - ev.innovations[minus]) / (2 * step)
-    d_log_s = (np.log(ev.variances[plus]) - np.log(ev.variances[minus])) / (2 * step)
+    gradient = (nll[:, plus] - nll[:, minus]) / (2 * step)
+    d_e = (e[:, plus] - e[:, minus]) / (2 * step)
+    d_log_s = (log_s[:, plus] - log_s[:, minus]) / (2 * step)
     # A perturbed set that is invalid leaves its coordinate out of this step.
-    ok = np.isfinite(gradient) & np.isfinite(d_e).all(axis=1) & np.isfinite(d_log_s).all(axis=1)
+    ok = np.isfinite(gradient) & np.isfinite(d_e).all(axis=2) & np.isfinite(d_log_s).all(axis=2)
     d_e[~ok], d_log_s[~ok] = 0.0, 0.0
-    fisher = (d_e / ev.variances[0]) @ d_e.T + 0.5 * d_log_s @ d_log_s.T
-    fisher[~ok, ~ok] = 1.0
-    return float(ev.nll[0]), np.where(ok, gradient, 0.0), fisher
+    fisher = (d_e * np.exp(-log_s[:, :1])) @ np.swapaxes(d_e, 1, 2)
+    fisher += 0.5 * d_log_s @ np.swapaxes(d_log_s, 1, 2)
+    fisher[:, np.arange(q), np.arange(q)] += ~ok
+    valid = np.isfinite(nll[:, 0])
+    fisher[~valid] = np.eye(q)
+    return np.where(valid, nll[:, 0], np.inf), np.where(ok & valid[:, None], gradient, 0.0), fisher
 
 
-def local_search(
+def trust_steps(hessian: np.ndarray, gradient: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Per start, the d minimising gᵀd + ½ dᵀHd within |d| ≤ radius for a positive semi-definite
+    H (m, q, q): d = −(H + μI)⁻¹ g with the smallest μ ≥ 0 that keeps |d| ≤ radius. μ by Newton's
+    method on 1/|d(μ)| = 1/radius in the eigenbasis of H, which rises monotonically to the root
+    from any μ with |d(μ)| > radius (Moré & Sorensen 1983)."""
+    curvature, basis = np.linalg.eigh(hessian)
+    # A flat direction keeps a tiny curvature: its step is then long, and μ takes it in (|g|/Δ
+    # sets the scale when H is all flat).
+    scale = np.maximum(np.abs(curvature).max(axis=1), np.linalg.norm(gradient, axis=1) / radius)
+    curvature = np.maximum(curvature, 1e-12 * scale[:, None])
+    g = (np.swapaxes(basis, 1, 2) @ gradient[..., None])[..., 0]
+    mu = np.zeros(len(g))
+    for _ in range(_SECULAR_STEPS):
+        inverse = 1.0 / (curvature + mu[:, None])
+        squared = np.sum((g * inverse) ** 2, axis=1)
+        slope = np.sum(g**2 * inverse**3, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rise = (np.sqrt(squared) / radius - 1.0) * squared / slope
+        # The Newton step already within the region: μ stays 0.
+        mu = np.maximum(mu + np.where(slope > 0, rise, 0.0), 0.0)
+    return -(basis @ (g / (curvature + mu[:, None]))[..., None])[..., 0]
+
+
+@dataclass
+class LocalSearch:
+    """One trust-region search: the point ξ, −ln L there with its gradient and Fisher matrix,
+    the trust radius (in ξ), −ln L after each accepted step, the iterations (accepted or not)
+    and why it stopped (None while it runs)."""
+
+    xi: np.ndarray
+    nll: float
+    gradient: np.ndarray
+    hessian: np.ndarray
+    radius: float = _INITIAL_RADIUS
+    history: list[float] = field(default_factory=list)
+    iterations: int = 0
+    message: str | None = None
+
+    def __post_init__(self) -> None:
+        self.history = [self.nll]
+
+    def advance(
+        self, step: np.ndarray, nll: float, gradient: np.ndarray, hessian: np.ndarray
+    ) -> None:
+        """Take or refuse the trial point ξ + step by the ratio of the actual decrease to the
+        model's, and resize the trust region (Nocedal & Wright 2006, Algorithm 4.1)."""
+        self.iterations += 1
+        promised = -(self.gradient @ step + 0.5 * step @ self.hessian @ step)
+        ratio = (self.nll - nll) / promised if promised > 0 else -np.inf
+        if ratio < 0.25:
+            self.radius *= 0.25
+        elif ratio > 0.75 and np.linalg.norm(step) > 0.99 * self.radius:
+            self.radius = min(2.0 * self.radius, _MAX_RADIUS)
+        if ratio > _ACCEPT:
+            self.xi = self.xi + step
+            self.nll, self.gradient, self.hessian = nll, gradient, hessian
+            self.history.append(nll)
+
+    def check(self, settings: LikelihoodSettings) -> None:
+        """Stop when |∇| < gtol, when −ln L fell by less than ftol over the last ``_PATIENCE``
+        accepted steps, when the quadratic model promises less than ftol (Newton decrement),
+        or after ``max_iter`` iterations."""
+        history = self.history
+        if not np.isfinite(self.nll):
+            self.message = "no finite likelihood at the start"
+        elif np.linalg.norm(self.gradient) < settings.gtol:
+            self.message = "gradient below gtol"
+        elif len(history) > _PATIENCE and history[-1 - _PATIENCE] - history[-1] < settings.ftol:
+            self.message = f"−ln L fell by less than ftol over {_PATIENCE} steps"
+        elif self.decrement() < settings.ftol:
+            self.message = "the quadratic model promises less than ftol"
+        elif self.iterations >= settings.max_iter:
+            self.message = "max_iter reached"
+        elif self.radius < _MIN_RADIUS:
+            self.message = "trust region collapsed"
+
+    def decrement(self) -> float:
+        """½ gᵀH⁺g: the decrease the quadratic model still promises."""
+        return 0.5 * self.gradient @ np.linalg.lstsq(self.hessian, self.gradient, rcond=1e-12)[0]
+
+
+def local_searches(
     objective: LikelihoodObjective, xi0: np.ndarray, settings: LikelihoodSettings
-) -> scipy.optimize.OptimizeResult:
-    """scipy ``trust-exact`` over ξ from xi0; one batched filter per point gives −ln L, ∇ and the
-    Hessian together (kept for the few points the method asks about again)."""
-    cache: dict[bytes, tuple[float, np.ndarray, np.ndarray]] = {}
-
-    def at(xi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-        key = xi.tobytes()
-        if key not in cache:
-            if len(cache) > 4:
-                cache.clear()
-            cache[key] = derivatives(objective, xi)
-        return cache[key]
-
-    history = [np.inf]
-
-    def stalled(intermediate_result: scipy.optimize.OptimizeResult) -> None:
-        # Only accepted steps count: a rejected one shrinks the trust region and tries again.
-        if intermediate_result.fun < history[-1]:
-            history.append(float(intermediate_result.fun))
-        if len(history) > _PATIENCE + 1 and history[-1 - _PATIENCE] - history[-1] < settings.ftol:
-            raise StopIteration
-        # Newton decrement: the decrease the quadratic model still promises.
-        _, gradient, hessian = at(intermediate_result.x)
-        step = np.linalg.lstsq(hessian, gradient, rcond=1e-12)[0]
-        if 0.5 * gradient @ step < settings.ftol:
-            raise StopIteration
-
-    return scipy.optimize.minimize(
-        lambda xi: at(xi)[:2],
-        xi0,
-        jac=True,
-        hess=lambda xi: at(xi)[2],
-        method="trust-exact",
-        callback=stalled,
-        options={"gtol": settings.gtol, "maxiter": settings.max_iter},
-    )
+) -> list[LocalSearch]:
+    """Trust-region Fisher scoring over ξ from every start (m, q) in lockstep: each iteration
+    filters the stencils of all running searches' trial points in one batch."""
+    searches = [LocalSearch(*at) for at in zip(xi0, *derivatives(objective, xi0), strict=True)]
+    for search in searches:
+        search.check(settings)
+    while running := [s for s in searches if s.message is None]:
+        steps = trust_steps(
+            np.array([s.hessian for s in running]),
+            np.array([s.gradient for s in running]),
+            np.array([s.radius for s in running]),
+        )
+        trial = derivatives(objective, np.array([s.xi for s in running]) + steps)
+        for search, step, *at in zip(running, steps, *trial, strict=True):
+            search.advance(step, *at)
+            search.check(settings)
+    return searches
 
 
 def observed_information(
@@ -388,25 +489,56 @@ class Uncertainty:
         }
 
 
+def wald(hessian: np.ndarray, held: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Covariance (q, q), standard errors (q,) and loading on flat directions (q,) from the
+    Hessian of −ln L with the coordinates ``held`` fixed at their estimates (zero covariance).
+    A coordinate loading more than 0.1 on a direction of (near-)zero curvature gets an infinite
+    error."""
+    free = ~held
+    sub = hessian[np.ix_(free, free)]
+    eigval, eigvec = np.linalg.eigh(0.5 * (sub + sub.T))
+    determined = eigval > 1e-10 * max(float(eigval.max(initial=0.0)), 0.0)
+    covariance = np.zeros_like(hessian)
+    kept = eigvec[:, determined]
+    covariance[np.ix_(free, free)] = (kept / eigval[determined]) @ kept.T
+    loading = np.zeros(len(hessian))
+    loading[free] = np.abs(eigvec[:, ~determined]).max(axis=1, initial=0.0)
+    se = np.where(loading > 0.1, np.inf, np.sqrt(np.maximum(np.diag(covariance), 0.0)))
+    return covariance, se, loading
+
+
 def uncertainty(space: LikelihoodSpace, z: np.ndarray, hessian: np.ndarray) -> Uncertainty:
     """Standard errors and correlations from the Hessian of −ln L in z (its inverse is the
-    asymptotic covariance); directions of (near-)zero curvature get infinite errors."""
-    eigval, eigvec = np.linalg.eigh(0.5 * (hessian + hessian.T))
-    determined = eigval > 1e-10 * max(float(eigval.max()), 0.0)
-    covariance = (eigvec[:, determined] / eigval[determined]) @ eigvec[:, determined].T
-    flat = (np.abs(eigvec[:, ~determined]) > 0.1).any(axis=1)
-    se_z = np.where(flat, np.inf, np.sqrt(np.maximum(np.diag(covariance), 0.0)))
+    asymptotic covariance); directions of (near-)zero curvature get infinite errors.
+
+    A parameter whose 95 % interval is wider than its whole range (``LikelihoodSpace.widths``)
+    carries no information: it is held at its estimate, the widest first, and the others' errors
+    are computed again, as the pseudo-inverse does for a flat direction. Otherwise its trade-off
+    with a determined parameter (e.g. a sensor noise heading to 0 against the air's process
+    noise) widens that one's interval by an amount that depends on where along the flat valley
+    the search stopped. A held parameter keeps the error it had when held; the correlations are
+    those of the full covariance."""
+    covariance, se_z, loading = wald(hessian, np.zeros(len(hessian), dtype=bool))
     with np.errstate(invalid="ignore", divide="ignore"):
         correlation = covariance / np.outer(se_z, se_z)
-    width = 2 * Z_95 * se_z
+    # Directions of zero curvature are left out of the inverse already: hold their parameters.
+    held, errors, se = loading > 0.1, se_z.copy(), se_z
+    while True:
+        excess = np.where(held, 0.0, 2 * Z_95 * se / space.widths)
+        if excess.max(initial=0.0) <= 1.0:
+            break
+        held[np.argmax(excess)] = True
+        _, se, _ = wald(hessian, held)
+        errors[~held] = se[~held]
+    width = 2 * Z_95 * errors
     wide = np.where(space.logarithmic, width > np.log(IDENTIFIABLE_SPAN), width > 1.0)
     return Uncertainty(
         names=list(space.names),
         estimates=space.values(z)[0],
-        std_errors=se_z * np.abs(space.value_scale(z)),
-        coordinate_std_errors=se_z,
+        std_errors=errors * np.abs(space.value_scale(z)),
+        coordinate_std_errors=errors,
         correlation=np.where(np.isfinite(correlation), correlation, np.nan),
-        non_identifiable=[n for n, w in zip(space.names, wide | flat, strict=True) if w],
+        non_identifiable=[n for n, w in zip(space.names, wide | held, strict=True) if w],
     )
 
 
@@ -474,10 +606,12 @@ def fit_likelihood(
     starts = space.from_unit(good)
     # The screen scored every point at its best overall noise level: start there.
     starts[:, space.space.dim :] += 0.5 * np.log(objective(starts).noise_scale())[:, None]
-    runs = [local_search(objective, xi0, settings) for xi0 in space.to_search(starts)]
-    best = min(runs, key=lambda r: r.fun)
-    records = [{"nll": float(r.fun), "iterations": int(r.nit), "message": r.message} for r in runs]
-    return summarise(objective, space.from_search(best.x), records)
+    runs = local_searches(objective, space.to_search(starts), settings)
+    best = min(runs, key=lambda r: r.nll)
+    records = [
+        {"nll": float(r.nll), "iterations": r.iterations, "message": r.message} for r in runs
+    ]
+    return summarise(objective, space.from_search(best.xi), records)
 
 
 def summarise(objective: LikelihoodObjective, z: np.ndarray, starts: list[dict]) -> LikelihoodFit:
