@@ -19,15 +19,24 @@ pavilion of the test bed, ``archetypes.LIGHT``):
 Comfort band in occupied hours (at least a fifth of the people in: weekdays 07–18, the office's
 Saturdays 08–12): the thermostat's occupied setpoint to 24 °C (the office: 20.4 °C, its
 area-weighted setpoint — 21 °C rooms, 18 °C hall). Outside them the thermostat's setback as lower
-edge (none where it lets the building float). The MPC minimises heating energy; the cost under a
-time-of-use price is reported for both. One E+ run per building and loop, not one per day: the
-runtime API applies each decision in the step it was taken, where re-running EnergyPlus per
-decision would cost a whole simulation per step.
+edge (none where it lets the building float). The MPC minimises heating energy, or with
+``--objective cost`` the cost under a time-of-use price; the cost is reported for both. One E+
+run per building and loop, not one per day: the runtime API applies each decision in the step it
+was taken, where re-running EnergyPlus per decision would cost a whole simulation per step.
 
-    python benchmarks/closed_loop.py [--weeks 4] [--buildings office light] [--plot docs/mpc]
+The controller's back-offs (margin, band kept before and after occupancy) are chosen per building
+on tuning weeks held apart from the test weeks (5–18 Dec 2016, trained on the 3 weeks before):
+``--tune`` tries each setting of GRID there, picks one by the rule of ``choose`` and writes it to
+``docs/mpc/tuned.json``; the reporting run reads it and runs the 4 test weeks (23 Jan – 19 Feb
+2017).
 
-Prints a JSON line per building, then the summary as the LAST line (sums over buildings,
-savings relative to the thermostat's total).
+    python benchmarks/closed_loop.py --tune            # tuning weeks → docs/mpc/tuned.json
+    python benchmarks/closed_loop.py [--objective energy|cost] [--weeks 4]
+        [--buildings office light] [--plot docs/mpc] [--rows DIR]
+
+Prints a JSON line per building (per setting with --tune), then the summary as the LAST line
+(the test weeks: sums over buildings, savings relative to the thermostat's total; --tune: the
+settings chosen).
 """
 
 from __future__ import annotations
@@ -43,7 +52,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from datetime import date, timedelta
 from pathlib import Path
 
@@ -68,18 +77,47 @@ ADMIN_TOKEN = "closed-loop-admin-token-0123456789abcdef"
 STEP = pd.Timedelta(minutes=15)
 # A Monday after the light pavilion's holiday closure (23 Dec – 6 Jan), so that its first fit
 # sees heated days.
-TEST_START = date(2017, 1, 23)
+TEST_START, TEST_WEEKS = date(2017, 1, 23), 4
+# The tuning weeks: held apart from the test weeks, before the closure (their training weeks,
+# 14 Nov – 4 Dec, are heated days of both buildings).
+TUNE_START, TUNE_WEEKS = date(2016, 12, 5), 2
 TRAIN_DAYS = 21
 HORIZON_H = 24.0
 RECALIBRATION_DAYS = 14
 T_MAX = 24.0  # [°C]
-# The plan aims this far above the band's lower edge: a back-off against model error. [K]
-MARGIN_K = 0.3
-# The band is kept from this long before occupancy to this long after it (see Loop.decide).
-BACKOFF_BEFORE, BACKOFF_AFTER = pd.Timedelta(minutes=30), pd.Timedelta(minutes=15)
 # Time-of-use price: peak on weekdays 08–20 local. [€/kWh of heat]
 PEAK_PRICE, OFF_PEAK_PRICE = 0.30, 0.15
 CONTRACT = ["t_in", "t_out", "ghi", "dni", "dhi", "q_hvac", "q_occ", "q_light", "wind_speed"]
+TUNED = ROOT / "docs" / "mpc" / "tuned.json"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The controller's back-offs against model error: the plan aims ``margin_k`` [K] above the
+    band's lower edge, and keeps the band from ``before_min`` minutes before occupancy to
+    ``after_min`` minutes after it. objective: "energy", or "cost" under the time-of-use price."""
+
+    margin_k: float
+    before_min: int
+    after_min: int
+    objective: str = "energy"
+
+
+# The grid --tune searches, and the rule that picks from it (choose), both fixed before tuning.
+GRID = [Settings(m, 30, a) for m in (0.3, 0.5) for a in (15, 30)]
+
+
+def choose(results: list[tuple[Settings, dict]]) -> Settings:
+    """Of the settings whose discomfort on the tuning weeks is no more than the thermostat's,
+    the one of least heating energy; if none, the one of least discomfort."""
+    comfortable = [
+        (r["energy_kWh_m2_mpc"], s)
+        for s, r in results
+        if r["discomfort_Kh_mpc"] <= r["discomfort_Kh_thermostat"]
+    ]
+    if comfortable:
+        return min(comfortable, key=lambda pair: pair[0])[1]
+    return min(results, key=lambda pair: pair[1]["discomfort_Kh_mpc"])[0]
 
 
 # --- buildings ----------------------------------------------------------------------------------
@@ -418,6 +456,7 @@ class Loop:
     """The controller side of the loop: what happens at the start of each EnergyPlus step."""
 
     plant: Plant
+    settings: Settings
     tenant: Tenant
     forecast: pd.DataFrame  # the baseline's weather and gains, UTC rows
     shares: dict[str, float]
@@ -447,16 +486,29 @@ class Loop:
             and now.minute == 0
         ):
             self.calibrations.append(self.tenant.calibrate(RECALIBRATION_DAYS))
+        started = time.perf_counter()
+        answer = self.tenant.plan(self._request(now))
+        self.plan_s.append(time.perf_counter() - started)
+        self.solve_s.append(answer["solve_s"])
+        self.infeasible += not answer["feasible"]
+        self.q_last = answer["q_hvac"][0]
+        return {z: self.q_last * share for z, share in self.shares.items()}
+
+    def _request(self, now: pd.Timestamp) -> dict:
+        """The body of ``POST /plan`` for the horizon starting at ``now``."""
         rows = pd.date_range(now, periods=round(HORIZON_H / 0.25), freq=STEP)
         # Back-off in time too, against the model's error on how fast the building warms up
         # and cools down: an end of step is held to the band if occupancy starts within
-        # BACKOFF_BEFORE after it or ended within BACKOFF_AFTER before it.
+        # before_min after it or ended within after_min before it.
         occupied = np.zeros(len(rows), dtype=bool)
-        for shift in (BACKOFF_BEFORE, pd.Timedelta(0), -BACKOFF_AFTER):
+        before = pd.Timedelta(minutes=self.settings.before_min)
+        after = pd.Timedelta(minutes=self.settings.after_min)
+        for shift in (before, pd.Timedelta(0), -after):
             occupied |= band(self.plant, rows + STEP + shift)[0]
         setback = np.nan if self.plant.setback is None else self.plant.setback
+        margin = self.settings.margin_k
         # The setback needs no back-off: nobody is there to feel a few tenths below it.
-        t_min = np.where(occupied, self.plant.t_min_occupied, setback - MARGIN_K)
+        t_min = np.where(occupied, self.plant.t_min_occupied, setback - margin)
         t_max = np.where(occupied, T_MAX, np.nan)
         body = {
             "start": format_times(pd.DatetimeIndex([now]), self.plant.timezone)[0],
@@ -464,15 +516,11 @@ class Loop:
             "t_min": [None if np.isnan(v) else float(v) for v in t_min],
             "t_max": [None if np.isnan(v) else float(v) for v in t_max],
             "q_max": self.plant.q_max,
-            "margin": MARGIN_K,
+            "margin": margin,
         }
-        started = time.perf_counter()
-        answer = self.tenant.plan(body)
-        self.plan_s.append(time.perf_counter() - started)
-        self.solve_s.append(answer["solve_s"])
-        self.infeasible += not answer["feasible"]
-        self.q_last = answer["q_hvac"][0]
-        return {z: self.q_last * share for z, share in self.shares.items()}
+        if self.settings.objective == "cost":
+            body["price"] = price(self.plant, rows).tolist()
+        return body
 
     @property
     def q_zero(self) -> dict[str, float]:
@@ -490,33 +538,69 @@ class Loop:
         self.measured.append({"time": row, "t_in": t_in, "q_hvac": self.q_last})
 
 
-def run_building(plant: Plant, weeks: int, folder: Path) -> tuple[dict, pd.DataFrame]:
-    """Thermostat run, then the MPC loop on the same weeks; the KPIs of both and the rows."""
-    test_last = TEST_START + timedelta(days=7 * weeks - 1)
-    train_first = TEST_START - timedelta(days=TRAIN_DAYS)
-    thermostat, zone_heat = plant.baseline(RunPeriod(train_first, test_last + timedelta(days=1)))
-    thermostat = thermostat[[c for c in CONTRACT if c in thermostat.columns]]
-    offset = pd.Timedelta(hours=1.0)  # Torino standard time, EnergyPlus's clock
-    lead_in = pd.Timestamp(TEST_START - timedelta(days=1)).tz_localize("UTC") - offset
-    start = lead_in + pd.Timedelta(days=1)
-    end = pd.Timestamp(test_last + timedelta(days=1)).tz_localize("UTC") - offset
-    replay = _by_zone(zone_heat, list(plant.zone_areas))
+@dataclass(frozen=True)
+class Period:
+    """Weeks of the loop and the thermostat's run over them and their training weeks: the
+    baseline, the forecast rows, and the heat by zone to replay. Times UTC."""
+
+    first_day: date  # the first controlled day, a Monday
+    weeks: int
+    thermostat: pd.DataFrame
+    replay: pd.DataFrame  # the thermostat's heat by zone [W]
+
+    @property
+    def last_day(self) -> date:
+        return self.first_day + timedelta(days=7 * self.weeks - 1)
+
+    @property
+    def train_first(self) -> date:
+        return self.first_day - timedelta(days=TRAIN_DAYS)
+
+    def utc(self, day: date) -> pd.Timestamp:
+        """Local midnight starting ``day`` (Torino standard time, EnergyPlus's clock)."""
+        return pd.Timestamp(day).tz_localize("UTC") - pd.Timedelta(hours=1.0)
+
+
+def thermostat_run(plant: Plant, first_day: date, weeks: int) -> Period:
+    """EnergyPlus under the building's thermostat over the training and the controlled weeks."""
+    last_day = first_day + timedelta(days=7 * weeks - 1)
+    train_first = first_day - timedelta(days=TRAIN_DAYS)
+    frame, zone_heat = plant.baseline(RunPeriod(train_first, last_day + timedelta(days=1)))
+    frame = frame[[c for c in CONTRACT if c in frame.columns]]
+    return Period(first_day, weeks, frame, _by_zone(zone_heat, list(plant.zone_areas)))
+
+
+def run_building(
+    plant: Plant, period: Period, settings: Settings, folder: Path
+) -> tuple[dict, pd.DataFrame]:
+    """The MPC loop over ``period``'s weeks; the KPIs of it and the thermostat, and the rows."""
+    thermostat, replay = period.thermostat, period.replay
+    lead_in = period.utc(period.first_day - timedelta(days=1))
+    start, end = period.utc(period.first_day), period.utc(period.last_day + timedelta(days=1))
     heat = replay[replay.index < lead_in].sum()
     shares = (heat / heat.sum()).to_dict()
     service = Service(folder)
     try:
         tenant = Tenant.register(service, plant.description, plant.timezone)
-        # The contract wants t_in in some row and q_hvac in every row of an upload: the
-        # forecast rows go with the training rows, heat planned as none until measured.
-        future = thermostat[thermostat.index >= lead_in].assign(t_in=np.nan, q_hvac=0.0)
-        tenant.upload(pd.concat([thermostat[thermostat.index < lead_in], future]))
+        # The first fit holds out the last day uploaded: the Friday, not the weekend, where a
+        # building kept at a constant setback all day is persistence's perfect forecast, which
+        # the service's promotion gate would refuse to lose to.
+        fit_end = lead_in - pd.Timedelta(days=1)
+        tenant.upload(thermostat[thermostat.index < fit_end])
         first_fit = tenant.calibrate(RECALIBRATION_DAYS)
+        if first_fit != "promoted":
+            raise RuntimeError(f"{plant.name}: the first fit was {first_fit}: no model to plan on")
+        # The contract wants t_in in some row and q_hvac in every row of an upload: the
+        # forecast rows go with the Saturday's, heat planned as none until measured.
+        future = thermostat[thermostat.index >= lead_in].assign(t_in=np.nan, q_hvac=0.0)
+        saturday = (thermostat.index >= fit_end) & (thermostat.index < lead_in)
+        tenant.upload(pd.concat([thermostat[saturday], future]))
         forecast = future.drop(columns=["t_in", "q_hvac"])
-        first = pd.Timestamp(train_first - timedelta(days=1)).tz_localize("UTC") - offset
-        loop = Loop(plant, tenant, forecast, shares, replay, first, lead_in, end)
+        first = period.utc(period.train_first - timedelta(days=1))
+        loop = Loop(plant, settings, tenant, forecast, shares, replay, first, lead_in, end)
         started = time.perf_counter()
         EnergyPlusRuntime().run(
-            plant.controlled_idf(RunPeriod(train_first, test_last)),
+            plant.controlled_idf(RunPeriod(period.train_first, period.last_day)),
             plant.epw,
             folder,
             list(plant.zone_areas),
@@ -527,7 +611,8 @@ def run_building(plant: Plant, weeks: int, folder: Path) -> tuple[dict, pd.DataF
         service.close()
     result, rows = _compare(plant, thermostat, loop, start, end)
     extra = {"calibrations": [first_fit, *loop.calibrations], "loop_wall_s": round(loop_s, 1)}
-    return {"building": plant.name, "weeks": weeks, **result, **extra}, rows
+    head = {"building": plant.name, "weeks": period.weeks, "first_day": str(period.first_day)}
+    return {**head, "settings": asdict(settings), **result, **extra}, rows
 
 
 def _compare(
@@ -574,7 +659,7 @@ def _by_zone(zone_heat: pd.DataFrame, zone_names: list[str]) -> pd.DataFrame:
     )
 
 
-def plot_week(plant: Plant, rows: pd.DataFrame, path: Path) -> None:
+def plot_week(plant: Plant, rows: pd.DataFrame, path: Path, objective: str) -> None:
     """Temperatures, band, heat and price over the first test week."""
     import matplotlib
 
@@ -601,7 +686,8 @@ def plot_week(plant: Plant, rows: pd.DataFrame, path: Path) -> None:
     top.set_ylabel("t_in [°C]")
     top.legend(loc="lower right", fontsize=8)
     top.set_title(
-        f"{plant.name}: first test week in EnergyPlus, MPC over the service vs thermostat"
+        f"{plant.name}: first test week in EnergyPlus, MPC over the service ({objective} "
+        "objective) vs thermostat"
     )
     middle.step(
         local,
@@ -627,25 +713,66 @@ PLANTS = {"office": office_plant, "light": light_plant}
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--weeks", type=int, default=4)
+    parser.add_argument(
+        "--tune", action="store_true", help="choose each building's settings on the tuning weeks"
+    )
+    parser.add_argument("--weeks", type=int, default=None, help="default: 4 test, 2 tuning")
     parser.add_argument("--buildings", nargs="+", choices=sorted(PLANTS), default=list(PLANTS))
+    parser.add_argument("--objective", choices=("energy", "cost"), default="energy")
+    parser.add_argument("--settings", type=Path, default=TUNED, help="settings per building")
     parser.add_argument("--plot", type=Path, default=ROOT / "docs" / "mpc", help="PNG folder")
     parser.add_argument("--rows", type=Path, default=None, help="folder for the rows as CSV")
     args = parser.parse_args()
+    if args.tune:
+        tune(args.buildings, args.weeks or TUNE_WEEKS, args.settings)
+    else:
+        report(args)
+
+
+def tune(names: list[str], weeks: int, path: Path) -> None:
+    """Each building's settings from GRID by the rule of ``choose`` on the tuning weeks, merged
+    into the JSON file at ``path``; the choice printed as the last line."""
+    chosen = json.loads(path.read_text()) if path.exists() else {}
+    for name in names:
+        plant = PLANTS[name]()
+        period = thermostat_run(plant, TUNE_START, weeks)
+        results = []
+        for settings in GRID:
+            with tempfile.TemporaryDirectory(prefix=f"closed-loop-tune-{name}-") as tmp:
+                result, _ = run_building(plant, period, settings, Path(tmp))
+            print(json.dumps(result), flush=True)
+            results.append((settings, result))
+        chosen[name] = asdict(choose(results))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(chosen, indent=2) + "\n")
+    print(json.dumps({"tuning_first_day": str(TUNE_START), "weeks": weeks, "chosen": chosen}))
+
+
+def report(args: argparse.Namespace) -> None:
+    """The test weeks with each building's tuned settings and the objective asked for."""
+    if not args.settings.exists():
+        raise SystemExit(f"no settings at {args.settings}: run with --tune first")
+    tuned = json.loads(args.settings.read_text())
+    weeks = args.weeks or TEST_WEEKS
+    suffix = "" if args.objective == "energy" else f"_{args.objective}"
     results = []
     for name in args.buildings:
+        if name not in tuned:
+            raise SystemExit(f"{args.settings} has no settings for {name}: run --tune for it")
         plant = PLANTS[name]()
+        settings = replace(Settings(**tuned[name]), objective=args.objective)
+        period = thermostat_run(plant, TEST_START, weeks)
         with tempfile.TemporaryDirectory(prefix=f"closed-loop-{name}-") as tmp:
-            result, rows = run_building(plant, args.weeks, Path(tmp))
-        plot_week(plant, rows, args.plot / f"{name}_week.png")
+            result, rows = run_building(plant, period, settings, Path(tmp))
+        plot_week(plant, rows, args.plot / f"{name}_week{suffix}.png", args.objective)
         if args.rows is not None:
-            rows.to_csv(args.rows / f"{name}_rows.csv")
+            rows.to_csv(args.rows / f"{name}_rows{suffix}.csv")
         results.append(result)
         print(json.dumps(result), flush=True)
-    print(json.dumps(summary(results, args.weeks)))
+    print(json.dumps(summary(results, weeks, args.objective)))
 
 
-def summary(results: list[dict], weeks: int) -> dict:
+def summary(results: list[dict], weeks: int, objective: str) -> dict:
     """All buildings together: savings on the summed energy [kWh] and cost, discomfort summed,
     peaks summed (the buildings as one portfolio), the mean time per decision."""
     area = {r["building"]: PLANTS[r["building"]]().floor_area for r in results}
@@ -658,6 +785,7 @@ def summary(results: list[dict], weeks: int) -> dict:
     return {
         "building": "+".join(r["building"] for r in results),
         "weeks": weeks,
+        "objective": objective,
         "energy_saving_pct": round(100.0 * (1.0 - energy["mpc"] / energy["thermostat"]), 2),
         "cost_saving_pct": round(100.0 * (1.0 - cost["mpc"] / cost["thermostat"]), 2),
         "discomfort_Kh_mpc": round(sum(r["discomfort_Kh_mpc"] for r in results), 3),

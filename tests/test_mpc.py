@@ -153,6 +153,22 @@ def test_bad_requests_are_named(change, words):
         plan(MODEL, np.full(3, 18.0), u, **request)
 
 
+def test_tuning_rule_takes_least_energy_within_the_thermostats_discomfort():
+    """The closed-loop harness's selection rule, fixed before tuning (benchmarks/closed_loop.py)."""
+    from benchmarks.closed_loop import GRID, choose
+
+    def tried(energy: list[float], discomfort: list[float]) -> list:
+        return [
+            (s, {"energy_kWh_m2_mpc": e, "discomfort_Kh_mpc": d, "discomfort_Kh_thermostat": 5.0})
+            for s, e, d in zip(GRID, energy, discomfort, strict=True)
+        ]
+
+    # The least energy (GRID[0]) is more discomfort than the thermostat's: the next least wins.
+    assert choose(tried([1.0, 2.0, 3.0, 4.0], [6.0, 5.0, 4.0, 3.0])) == GRID[1]
+    # None is within the thermostat's discomfort: the least discomfort wins, whatever its energy.
+    assert choose(tried([1.0, 2.0, 3.0, 4.0], [9.0, 8.0, 6.0, 7.0])) == GRID[2]
+
+
 @pytest.mark.energyplus
 def test_energyplus_runtime_binding_applies_the_decided_heat(tmp_path):
     """The closed-loop harness's ctypes binding: one callback per step of the run period, the
