@@ -16,9 +16,9 @@ filtered y − C x⁺, which includes the row's own measurement); train open-loo
 (``Estimator.rmse_``); coverage of the 95 % interval ±1.96 ``t_in_std`` of 1-day-ahead forecasts
 (SYSLAB: consecutive 24 h forecasts from the test start; office: the predicted days). Output
 error has no noise model: its intervals use the filter's fixed defaults and are only nominal.
-The peers' figures are quoted as issue 12 records them; they are not measured here. A last
-diagnostic refits the likelihood on Armadillo with q_hvac as the mean of consecutive rows (see
-:func:`measured_case`): the one-step gap to pySIP is in how the heating input is held.
+The peers' figures are quoted as issue 12 records them; they are not measured here. Armadillo's
+inputs are samples, which ``read_armadillo`` turns into the means over each step that the engine
+holds (see ``rcengine/io/measured.py``).
 
     python benchmarks/likelihood_peers.py [--repeats 7] [--every 7]
 
@@ -77,22 +77,13 @@ PEERS_RECORDED = {
 }
 
 
-def measured_case(
-    name: str, heater: bool = False, heating_interval_mean: bool = False
-) -> tuple[RCNetwork, Dataset, int]:
-    """The network, the record and the number of training rows of a measured building.
-
-    ``heating_interval_mean``: a diagnostic only; each row's q_hvac replaced by the mean of it and
-    the next, the power a linear interpolation of the samples delivers over the step (pySIP's
-    armadillo example interpolates its inputs so, ``hold_order=1``)."""
+def measured_case(name: str, heater: bool = False) -> tuple[RCNetwork, Dataset, int]:
+    """The network, the record and the number of training rows of a measured building."""
     building = Building.from_json(BUILDINGS / f"{name}.json")
     if name == "armadillo":
         frame = read_armadillo(MEASURED / "armadillo_data_H2.csv").iloc[:232]
     else:
         frame = read_syslab(MEASURED / "syslab_inputPRBS1.csv")
-    if heating_interval_mean:
-        power = frame["q_hvac"].to_numpy(dtype=float)
-        frame = frame.assign(q_hvac=np.append(0.5 * (power[:-1] + power[1:]), power[-1]))
     net = get_model("2r2c", building, frame.columns)
     if heater:
         net = with_heater(net, building.floor_area)
@@ -197,20 +188,6 @@ def measured_report(name: str, repeats: int, heater: bool = False) -> dict:
     return report
 
 
-def heating_hold_check() -> dict:
-    """Likelihood on Armadillo with q_hvac as the mean of consecutive rows (diagnostic)."""
-    net, data, n_train = measured_case("armadillo", heating_interval_mean=True)
-    est = fit(net, data.between(None, data.times[n_train]), "likelihood", NO_SUN)
-    hours = (len(data) - n_train) * data.step_s / 3600.0
-    fc = forecast(est.compiled, est.params_, data, data.times[n_train], hours, 1e4, est.noise_)
-    return {
-        "neg_log_likelihood": est.likelihood_.nll,
-        "noise": est.noise_.to_dict(est.compiled.state_names),
-        "test_open_loop_K": rmse(data.measured[n_train:], fc.t_in_pred),
-        "test_one_step_K": one_step_rmse(est, data, slice(n_train, None)),
-    }
-
-
 def office_report(every: int) -> dict:
     """``basic`` on the office: learn 7 days, predict the next, every ``every``-th study day."""
     building = Building.from_json(OFFICE / "building.json")
@@ -254,22 +231,31 @@ def main() -> None:
     syslab = measured_report("syslab", max(1, args.repeats // 3))
     syslab_heater = measured_report("syslab", 1, heater=True)
     office = office_report(args.every)
-    hold = heating_hold_check()
     print_table("Armadillo (162 rows train, 70 test, 2r2c without sun)", armadillo)
     print_table("SYSLAB (2/3 train, 2r2c)", syslab)
     print_table("SYSLAB (2/3 train, 2r2c+heater)", syslab_heater)
-    for name, case in (("SYSLAB 2r2c", syslab), ("SYSLAB 2r2c+heater", syslab_heater)):
+    cases = (
+        ("Armadillo", armadillo),
+        ("SYSLAB 2r2c", syslab),
+        ("SYSLAB 2r2c+heater", syslab_heater),
+    )
+    for name, case in cases:
         checks = case["likelihood"]["likelihood"]["residuals"]
         print(
             f"  {name} innovations white: {checks['white']} ({checks['acf_outside']} lags out, "
             f"periodogram {checks['cpgram_deviation']:.3f} vs band {checks['cpgram_band']:.3f})"
         )
+    ml = armadillo["likelihood"]
+    estimates = ", ".join(
+        f"{name} {p['estimate']:.4g} ± {p['std_error']:.2g}"
+        for name, p in ml["likelihood"]["uncertainty"]["parameters"].items()
+    )
+    print(f"Armadillo likelihood: −ln L {ml['likelihood']['neg_log_likelihood']:.2f}; {estimates}")
+    print(f"  noise: {ml['noise']}")
     for criterion, row in office.items():
         print(f"office, basic, {row['days']} days, {criterion}: {row}")
-    print(f"Armadillo, likelihood, q_hvac as the mean of consecutive rows (diagnostic): {hold}")
     print("peers, as recorded by issue 12 (not measured here):", PEERS_RECORDED)
     print(f"load average at the end: {os.getloadavg()}")
-    ml = armadillo["likelihood"]
     print(json.dumps({
         "armadillo_test_open_loop_K": round(ml["test_open_loop_K"], 4),
         "armadillo_test_one_step_K": round(ml["test_one_step_K"], 4),
@@ -291,10 +277,6 @@ def main() -> None:
             "syslab_heater_test_open_loop_K": round(
                 syslab_heater["output_error"]["test_open_loop_K"], 4
             ),
-        },
-        "armadillo_heating_interval_mean": {
-            "test_one_step_K": round(hold["test_one_step_K"], 4),
-            "test_open_loop_K": round(hold["test_open_loop_K"], 4),
         },
         "load_avg": os.getloadavg(),
     }))  # fmt: skip

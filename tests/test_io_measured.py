@@ -1,4 +1,5 @@
-"""The two measured buildings: sizes, steps, units against the raw files, and the chosen clocks."""
+"""The two measured buildings: sizes, steps, units against the raw files, the inputs as step means,
+and the chosen clocks."""
 
 from __future__ import annotations
 
@@ -88,16 +89,39 @@ def test_armadillo_rows_step_and_span(armadillo):
 
 
 def test_armadillo_units_against_the_raw_file(armadillo, shared_data):
-    time, t_ext, p_hea, i_sol, t_int = first_line(shared_data / ARMADILLO, ",")
-    assert time == 0.0
-    assert armadillo.iloc[0].tolist() == [t_int, t_ext, i_sol, p_hea]
+    raw = pd.read_csv(shared_data / ARMADILLO)
+    assert raw["Time"].iloc[0] == 0.0
+    np.testing.assert_array_equal(armadillo["t_in"], raw["T_int"])  # samples at t, unchanged
+    for column, source in [("t_out", "T_ext"), ("ghi", "I_sol"), ("q_hvac", "P_hea")]:
+        samples = raw[source].to_numpy()
+        assert armadillo[column].iloc[0] == pytest.approx((samples[0] + samples[1]) / 2)
+        assert armadillo[column].iloc[-1] == samples[-1]
+
+
+def test_armadillo_inputs_become_means_of_the_interpolated_samples(tmp_path):
+    """Inputs: (s_k + s_k+1)/2, the mean over [t_k, t_k+1) of the samples joined linearly; the
+    last row's samples held; the indoor temperature left as the sample at t."""
+    csv = tmp_path / "box.csv"
+    csv.write_text(
+        "Time,T_ext,P_hea,I_sol,T_int\n"
+        "0.0,10.0,0.0,0.0,20.0\n"
+        "1800.0,12.0,1980.0,100.0,20.5\n"
+        "3600.0,11.0,1920.0,300.0,21.5\n"
+    )
+    frame = read_armadillo(csv)
+    assert frame.index[1] - frame.index[0] == pd.Timedelta(minutes=30)
+    assert frame["t_in"].tolist() == [20.0, 20.5, 21.5]
+    assert frame["t_out"].tolist() == [11.0, 11.5, 11.0]
+    assert frame["q_hvac"].tolist() == [990.0, 1950.0, 1920.0]
+    assert frame["ghi"].tolist() == [50.0, 200.0, 300.0]
 
 
 def test_armadillo_value_ranges(armadillo):
     assert 25 < armadillo["t_in"].min() < armadillo["t_in"].max() < 45  # heated in summer
     assert 5 < armadillo["t_out"].min() < armadillo["t_out"].max() < 35
     assert 900 < armadillo["ghi"].max() < 1100  # clear midday sun on a horizontal sensor
-    assert set(np.unique(armadillo["q_hvac"])) <= set(np.arange(0.0, 2500.0, 60.0))
+    # Samples in 60 W steps, so their pairwise means in 30 W steps.
+    assert set(np.unique(armadillo["q_hvac"])) <= set(np.arange(0.0, 2500.0, 30.0))
 
 
 def test_armadillo_clock_is_french_summer_time(armadillo, project_data):

@@ -379,9 +379,11 @@ def test_armadillo_likelihood_beats_output_error_on_the_test_days(armadillo):
         est = Estimator(net, known=NO_SUN, criterion=criterion, random_state=0).fit(train)
         fc = forecast(est.compiled, est.params_, data, start, 35.0, 200.0, est.noise_)
         scores[criterion] = rmse(y, fc.t_in_pred)
-    assert scores["likelihood"] < 0.3 < scores["output_error"]
+    assert scores["likelihood"] < 0.25 < 0.3 < scores["output_error"]  # 0.25: issue 12's target
     u = est.likelihood_.uncertainty
-    assert set(u.non_identifiable) <= {"measurement_std"}
+    # With the inputs as step means the sensor noise is determined; the air's process noise heads
+    # to 0 (pySIP fixes it there) and is the one allowed to carry no information.
+    assert set(u.non_identifiable) <= {"process_std_air"}
     assert np.all(u.t_statistics[:4] > 5)  # every physical parameter well determined
     assert est.likelihood_.residuals.white
 

@@ -1,9 +1,13 @@
 """The two measured buildings of the reference data (``shared/data/measured``) as contract frames.
 
 Both files count time from the start of the experiment and carry no date; the start instant is
-a parameter, with the defaults below. Rows keep the files' own sampling: an input row (heating
-power, irradiance, outdoor temperature) is taken as holding over [t, t + dt), the indoor
-temperature as the value at t — the zero-order hold both source tools (CTSM-R, pySIP) apply.
+a parameter, with the defaults below. Rows keep the files' own step. A contract row's inputs
+(heating power, irradiance, outdoor temperature) are their means over [t, t + dt), which the
+engine holds over the step (zero-order hold); its indoor temperature is the value at t. SYSLAB's
+input rows are such means already and are kept as they are; Armadillo's are samples at t and are
+converted to interval means (below). How the files say which: their values, the indoor
+temperature's response to the heating switches, and the likelihood of the ``2r2c`` fits of
+``benchmarks/likelihood_peers.py`` (−ln L, lower is better) under each reading.
 
 SYSLAB (``syslab_inputPRBS1.csv``)
 ----------------------------------
@@ -17,11 +21,42 @@ Start: 2009-02-05 14:26 UTC, the instant the CTSM-R example gives to ``t = 0``
 than Danish time (UTC+1): with this start, the irradiance follows the computed sun elevation
 more closely than with the start an hour earlier or later (checked in the tests).
 
+Inputs: means over the 5 minutes after the stamp, kept as they are. The source does not say so;
+the data do. The values are averages of faster readings (``Ph`` 5.236667 kW); where the heaters
+switch, the first row after the switch holds a partial value (0.44–0.60 kW when off, 4.7–5.0 kW
+when on, against about 0.04 and 5.2 kW), and the indoor temperature's trend turns in the interval
+after that row, not in the one before. With the heaters as a state of their own (``2r2c+heater``,
+as in the CTSM-R models of these data): −ln L −3481 with the rows as they are, −3042 with each
+row replaced by the mean of it and the next (the reading of samples), −2670 with each row moved
+to the interval before its stamp.
+
 Armadillo Box (``armadillo_data_H2.csv``)
 -----------------------------------------
 Copy of the 42 m² lightweight wooden house of the 2010 Solar Decathlon Europe built on the INES
 test site, Le Bourget-du-Lac, France (pySIP examples). ``Time`` [s], ``T_ext`` [°C], ``P_hea``
 heating [W], ``I_sol`` solar irradiance [W/m²], ``T_int`` indoor mean [°C]; 30-minute rows.
+
+Inputs: samples at the stamp, converted to interval means. pySIP's own example for this file
+builds its model with ``hold_order=1``, the inputs interpolated linearly between the samples
+(locie/pySIP ``docs/examples/thermal_network/armadillo/fit_frequentist.ipynb``). The data agree:
+the heating starts and stops between stamps. At row 40 (20:00), the first non-zero ``P_hea``, the
+indoor temperature has already risen 0.9 K since row 39, whose sample reads 0 W; after row 135,
+the last non-zero sample, it falls 0.45 K in the first half hour and 1.56 K in the second.
+Holding each sample over the step after it misplaces that heat by up to a step. Each input is
+therefore replaced by its mean over [t_k, t_k+1) under linear interpolation, (s_k + s_k+1)/2:
+
+* ``P_hea`` and ``I_sol``, powers: the energy over the step is what enters the heat balance (and
+  the engine takes the sun's position at mid-interval, the instant of a mean, not of a sample).
+* ``T_ext``: it drives the envelope's heat flow linearly, so its mean over the step is the held
+  value that carries the same heat.
+* ``T_int`` stays the sample at t: the model's output is compared at the instants.
+
+The last row has no successor: its inputs keep their samples (held, not dropped). They only drive
+the state beyond the record's end, so the hold changes no fit or prediction within the record,
+while the row's indoor temperature is a measurement worth keeping. With the ``2r2c`` likelihood
+fit of the benchmark (no sun, 162 training rows): −ln L −205.8 with the interval means, −135.3
+with the samples held over the step after them, −158.1 with each sample taken as the mean of the
+step before it.
 
 Assumptions, not documented by the source:
 
@@ -63,7 +98,8 @@ def read_syslab(path: str | Path, start: str | pd.Timestamp = SYSLAB_START) -> p
 
     Returns
     -------
-    Validated frame on a UTC index, 5-minute rows. [°C, W/m², W]
+    Validated frame on a UTC index, 5-minute rows; inputs as in the file, already means over the
+    5 minutes after the stamp (module docstring). [°C, W/m², W]
     """
     raw = pd.read_csv(path, sep=";")
     return _contract_frame(
@@ -89,15 +125,28 @@ def read_armadillo(path: str | Path, start: str | pd.Timestamp = ARMADILLO_START
 
     Returns
     -------
-    Validated frame on a UTC index, 30-minute rows; ``ghi`` is the measured ``I_sol`` taken as
-    horizontal. [°C, W/m², W]
+    Validated frame on a UTC index, 30-minute rows. ``t_out``, ``ghi`` (``I_sol`` taken as
+    horizontal) and ``q_hvac``: the means over [t_k, t_k+1) of the linearly interpolated samples,
+    (s_k + s_k+1)/2, the last row's samples held; ``t_in``: the sample at t (module docstring).
+    [°C, W/m², W]
     """
     raw = pd.read_csv(path)
     return _contract_frame(
         start,
         raw["Time"].to_numpy(float),
-        {T_IN: raw["T_int"], T_OUT: raw["T_ext"], GHI: raw["I_sol"], Q_HVAC: raw["P_hea"]},
+        {
+            T_IN: raw["T_int"],
+            T_OUT: _interval_means(raw["T_ext"]),
+            GHI: _interval_means(raw["I_sol"]),
+            Q_HVAC: _interval_means(raw["P_hea"]),
+        },
     )
+
+
+def _interval_means(samples: pd.Series) -> pd.Series:
+    """Mean over each step [t_k, t_k+1) of the samples interpolated linearly, (s_k + s_k+1)/2;
+    the last sample, which has no successor, held (same unit as ``samples``)."""
+    return 0.5 * (samples + samples.shift(-1).fillna(samples))
 
 
 def _contract_frame(
