@@ -173,7 +173,6 @@ def forecast_frame(
     result = forecast(network, params, data, start, hours, history_h, noise)
     if not set(network.input_names) & {VENT_LOSS, WIND_LOSS}:
         return result, data
-    frame = frame.copy()
     for _ in range(LINEARISATION_PASSES):
         frame.loc[result.times, T_IN] = result.t_in_pred
         data = prepare(frame)

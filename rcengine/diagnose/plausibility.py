@@ -136,10 +136,16 @@ def assess(ext: Extension, params: Mapping[str, float]) -> Assessment:
     return Assessment({r.key: r.as_dict() for r in readings}, problems)
 
 
+def _readable_steady(ext: Extension, params: Mapping[str, float]) -> bool:
+    """Whether the fitted network's steady gains can be read: every parameter is given (not
+    only the extension's new ones) and q_hvac is there to scale them by."""
+    return set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals
+
+
 def _declared_g(ext: Extension, params: Mapping[str, float]) -> float:
     """The declared glazing's g-value in the fitted model: its steady aperture (the share of the
     transmitted sun reaching the air), else the sum of its gains when ``params`` is partial."""
-    if set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals:
+    if _readable_steady(ext, params):
         return solar_apertures(ext.network, dict(params)).get(SOLAR_WINDOW, 0.0)
     return sum(
         h.factor * (params.get(h.gain, 0.0) if isinstance(h.gain, str) else h.gain)
@@ -179,7 +185,7 @@ def _opaque(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     conducts more heat than the building loses."""
     orientations = ext.detail["orientations"]
     au = {k: params[f"au_opaque_{k}"] for k in orientations}
-    complete = set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals
+    complete = _readable_steady(ext, params)
     if complete:
         apertures = solar_apertures(ext.network, dict(params))
         au = {k: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] / R_SE for k in au}
@@ -272,7 +278,7 @@ def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     roof, fits 1.4)."""
     area = ext.detail["sky_view_area_m2"]
     u_sky = params["u_sky"]
-    if set(ext.network.parameters) <= set(params) and Q_HVAC in ext.network.signals:
+    if _readable_steady(ext, params):
         gains = steady_state_gains(ext.network, dict(params))
         u_sky = gains[SKY_DELTA] / gains[Q_HVAC] / (SKY_H_R_TYPICAL * R_SE * area)
     return [

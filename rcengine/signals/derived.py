@@ -101,12 +101,11 @@ def indoor_operating_point(frame: pd.DataFrame) -> np.ndarray:
 
 
 def mask_measured(frame: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
-    """``frame`` without the ``t_in`` measured from ``start`` on: what a forecast from ``start``
-    may not see, even through a derived input (``indoor_operating_point``)."""
-    if T_IN not in frame.columns or not (frame.index >= start).any():
-        return frame
+    """A copy of ``frame`` without the ``t_in`` measured from ``start`` on: what a forecast from
+    ``start`` may not see, even through a derived input (``indoor_operating_point``)."""
     masked = frame.copy()
-    masked.loc[masked.index >= start, T_IN] = np.nan
+    if T_IN in masked.columns:
+        masked.loc[masked.index >= start, T_IN] = np.nan
     return masked
 
 
