@@ -17,9 +17,12 @@ install: $(BIN)/.installed
 run: install
 	$(BIN)/rcservice serve --host 127.0.0.1 --port 8000
 
-test: install browser
-	$(BIN)/ruff check .
+test: install browser lint
 	$(BIN)/python -m pytest -q
+
+lint: install
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
 
 bench: install
 	for b in benchmarks/*.py; do $(BIN)/python $$b || exit 1; done

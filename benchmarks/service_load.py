@@ -191,9 +191,7 @@ def run_clients(client, latencies: list[list[float]]) -> tuple[float, np.ndarray
 
 
 def percentiles(latencies_ms: np.ndarray) -> dict[str, float]:
-    return {
-        f"p{q}_ms": round(float(np.percentile(latencies_ms, q)), 2) for q in (50, 95)
-    }
+    return {f"p{q}_ms": round(float(np.percentile(latencies_ms, q)), 2) for q in (50, 95)}
 
 
 def background(stop: threading.Event, action, pause_s: float) -> threading.Thread:

@@ -145,9 +145,7 @@ def forecast(
         filtered = initial_state(model, data, start, history_h)
     else:
         process_cov = noise.process_cov(network, params, data.step_s)
-        filtered = initial_state(
-            model, data, start, history_h, process_cov, noise.measurement_std
-        )
+        filtered = initial_state(model, data, start, history_h, process_cov, noise.measurement_std)
     times, u = future_inputs(data, start, steps, model.input_names)
     y, _ = model.simulate(u, filtered.state)
     return Forecast(times, y, filtered.state, model, filtered, output_std(model, filtered, steps))

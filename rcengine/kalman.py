@@ -161,9 +161,12 @@ def filter_batch(
         X_next[:, :, 0] += forcing[k]
         P_next += Q
         steady = k >= all_measured_from and k % _STEADY_CHECK == 0 and k + 1 < T
-        if steady and (
-            np.abs(P_next - P).max(axis=(1, 2)) <= _STEADY_RTOL * np.abs(P).max(axis=(1, 2))
-        ).all():
+        if (
+            steady
+            and (
+                np.abs(P_next - P).max(axis=(1, 2)) <= _STEADY_RTOL * np.abs(P).max(axis=(1, 2))
+            ).all()
+        ):
             rest = slice(k + 1, T)
             predicted[rest], X_next = _steady_rows(A, c, G, goal[rest], forcing[rest], X_next)
             np.subtract(goal[rest], predicted[rest], out=innovations[rest])

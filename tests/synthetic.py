@@ -20,7 +20,6 @@ from rcengine.signals import SignalOptions
 STEP_S = 900.0
 
 
-
 def office(**changes: object) -> Building:
     """The synthetic office in Turin (the thesis's sizes), with ``changes`` to its description."""
     description = {

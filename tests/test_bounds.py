@@ -52,8 +52,9 @@ SURFACE_MAX = 400.0 + 2 * 700.0  # facade, roof and ground floor [m²]
 
 
 def test_air_capacity_scales_with_volume():
-    small, large = building_bounds("basic", building_700()), building_bounds(
-        "basic", building_700(volume=4200.0)
+    small, large = (
+        building_bounds("basic", building_700()),
+        building_bounds("basic", building_700(volume=4200.0)),
     )
     assert small["c_air"] == pytest.approx((RHO_CP * 2100.0, 15 * RHO_CP * 2100.0))
     assert large["c_air"] == pytest.approx((2 * small["c_air"][0], 2 * small["c_air"][1]))

@@ -149,9 +149,16 @@ def test_candidates_without_their_inputs_are_skipped_with_the_reason(hidden_gain
     assert CANDIDATES["window_solar_gains"](ctx) == Skipped(
         "window_solar_gains", "no windows or facades ('windows', 'walls') in the building JSON"
     )
-    no_heating = Context(network, BUILDING, split_data(
-        frame.assign(q_hvac=0.0), BUILDING, network, SignalOptions(), frame.index[-1]
-    ).train, SignalOptions(), TRUTH_BASIC, np.zeros(len(data)))
+    no_heating = Context(
+        network,
+        BUILDING,
+        split_data(
+            frame.assign(q_hvac=0.0), BUILDING, network, SignalOptions(), frame.index[-1]
+        ).train,
+        SignalOptions(),
+        TRUTH_BASIC,
+        np.zeros(len(data)),
+    )
     assert "q_hvac is zero" in CANDIDATES["emitter_dynamics"](no_heating).reason
 
 

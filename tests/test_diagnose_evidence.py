@@ -20,8 +20,10 @@ from tests.test_diagnose import _hidden_gain
 
 HEALTHY = Health(reasons=(), on_bounds=())
 CRIPPLED = Health(
-    reasons=("c_wall ended on its upper bound 7.5e+05 J/(K·m²): stores more heat than any "
-             "construction of this building could",),
+    reasons=(
+        "c_wall ended on its upper bound 7.5e+05 J/(K·m²): stores more heat than any "
+        "construction of this building could",
+    ),
     on_bounds=("c_wall",),
 )
 
@@ -43,9 +45,7 @@ def _finding(effect: str, accepted: bool, **fields) -> Finding:
 
 def _evidence(before: list[float], after: list[float]) -> FoldEvidence:
     """Fold evidence whose test residuals are constant: each fold's RMSE is the value given."""
-    return FoldEvidence(
-        tuple(np.full(48, b) for b in before), tuple(np.full(48, a) for a in after)
-    )
+    return FoldEvidence(tuple(np.full(48, b) for b in before), tuple(np.full(48, a) for a in after))
 
 
 def test_verdict_names_what_is_missing_or_that_nothing_is():
@@ -75,15 +75,17 @@ def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
         pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
     )
     lucky = _finding("opaque_solar_gains", True)
-    confirm_on_folds(lucky, _evidence([1, 1, 1], [0.5, 1.2, 1.3]), folds, DiagnoseSettings(),
-                     "Europe/Rome")
+    confirm_on_folds(
+        lucky, _evidence([1, 1, 1], [0.5, 1.2, 1.3]), folds, DiagnoseSettings(), "Europe/Rome"
+    )
     assert not lucky.accepted
     assert lucky.reason.startswith("rejected across folds: helps in 1 of 3 folds")
     assert [f["rmse_test_after"] for f in lucky.folds["folds"]] == [0.5, 1.2, 1.3]
     assert lucky.folds["folds"][0]["test"] == folds[0].label("Europe/Rome")
     steady = _finding("window_solar_gains", True)
-    confirm_on_folds(steady, _evidence([1, 1, 1], [0.6, 0.7, 0.8]), folds, DiagnoseSettings(),
-                     "Europe/Rome")
+    confirm_on_folds(
+        steady, _evidence([1, 1, 1], [0.6, 0.7, 0.8]), folds, DiagnoseSettings(), "Europe/Rome"
+    )
     assert steady.accepted and "across folds: helps in 3 of 3 folds" in steady.reason
     assert steady.folds["helped"] == 3 and steady.folds["pooled_rmse_test_before"] == 1.0
 
@@ -106,7 +108,9 @@ def test_a_fold_trained_without_heating_but_tested_with_it_is_left_out():
 def test_of_two_passing_candidates_the_head_to_head_winner_is_taken_and_the_other_reported():
     window = _finding("window_solar_gains", True, evidence=_evidence([1, 1, 1], [0.6, 0.7, 0.5]))
     opaque = _finding(
-        "opaque_solar_gains", True, rmse_test_after=0.4,  # better on the single split
+        "opaque_solar_gains",
+        True,
+        rmse_test_after=0.4,  # better on the single split
         evidence=_evidence([1, 1, 1], [0.8, 0.6, 0.9]),
     )
     verdicts = {"opaque_solar_gains": opaque, "window_solar_gains": window}

@@ -49,8 +49,16 @@ def test_sun_bounds_are_thesis_table_2_4_and_need_surfaces():
 
 def test_per_area_scaling_in_matrices():
     net = get_model("basic", BUILDING).compile()
-    p = {"r_wall_ext": 2.0, "r_wall_int": 0.5, "r_int": 0.1, "c_wall": 1e5, "c_air": 1e6,
-         "c_int": 2e5, "alpha_wall": 10.0, "alpha_int": 5.0}
+    p = {
+        "r_wall_ext": 2.0,
+        "r_wall_int": 0.5,
+        "r_int": 0.1,
+        "c_wall": 1e5,
+        "c_air": 1e6,
+        "c_int": 2e5,
+        "alpha_wall": 10.0,
+        "alpha_int": 5.0,
+    }
     rc = net.rc_matrices(p)
     np.testing.assert_allclose(rc.capacity[0], [1e5 * 455, 1e6, 2e5 * 560])
     # conductance outdoor→wall is A_wall / r_wall_ext

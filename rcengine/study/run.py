@@ -150,13 +150,11 @@ def learn_and_predict(
     started, started_cpu = time.perf_counter(), time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(
-            network, preset=preset, random_state=random_state, criterion=criterion
-        ).fit(data.on_days(past))
+        est = Estimator(network, preset=preset, random_state=random_state, criterion=criterion).fit(
+            data.on_days(past)
+        )
     wall, cpu = time.perf_counter() - started, time.process_time() - started_cpu
-    times, predicted, measured = _forecast_days(
-        est.compiled, est.params_, data, ahead, est.noise_
-    )
+    times, predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead, est.noise_)
     return Prediction(est, wall, cpu, times, predicted, measured)
 
 

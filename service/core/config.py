@@ -62,8 +62,7 @@ class Settings(BaseSettings):
     )
     diagnosis_preset: str | None = Field(
         None,
-        description="Estimator preset of every fit of a diagnosis (default: the engine's, "
-        "study).",
+        description="Estimator preset of every fit of a diagnosis (default: the engine's, study).",
     )
     auto_adopt: bool = Field(
         False,
