@@ -15,6 +15,9 @@ the lower-level functions take the instants at which to evaluate the sun as give
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
@@ -65,6 +68,29 @@ def interval_midpoints(index: pd.DatetimeIndex) -> pd.DatetimeIndex:
     steps = pd.Series(np.diff(index.as_unit("ns").asi8))
     step = pd.Timedelta(int(steps.mode().iloc[0]), unit="ns")
     return index + step / 2
+
+
+def day_of_year(times: pd.DatetimeIndex) -> np.ndarray:
+    """Day of the year of each instant, on the UTC calendar as pvlib counts it (1–366). [-]
+
+    pvlib's functions take either instants or these numbers; given instants they read pandas'
+    deprecated ``dayofyear``, so the numbers are passed instead.
+    """
+    return np.asarray(times.tz_convert("UTC").day_of_year, dtype=float)
+
+
+@contextmanager
+def _pvlib_reads_dayofyear() -> Iterator[None]:
+    # pvlib 0.16.1's dirint and lookup_linke_turbidity read the deprecated DatetimeIndex.dayofyear
+    # themselves and take no day numbers instead; only that warning is silenced, only here.
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"DatetimeIndex\.dayofyear is deprecated")
+        yield
+
+
+def extra_radiation(times: pd.DatetimeIndex) -> np.ndarray:
+    """Extraterrestrial normal irradiance at each instant (pvlib, Spencer 1971). [W/m²]"""
+    return np.asarray(irradiance.get_extra_radiation(day_of_year(times)), dtype=float)
 
 
 def solar_position(times: pd.DatetimeIndex, location: Location) -> pd.DataFrame:
@@ -119,15 +145,16 @@ def decompose_ghi(
     ghi = np.clip(np.asarray(ghi, dtype=float), 0.0, None)
     zenith = position["zenith"].to_numpy()
     if model == "erbs":
-        dni = np.asarray(irradiance.erbs(ghi, zenith, times)["dni"], dtype=float)
+        dni = np.asarray(irradiance.erbs(ghi, zenith, day_of_year(times))["dni"], dtype=float)
     else:
-        dni = irradiance.dirint(
-            pd.Series(ghi, index=times),
-            pd.Series(zenith, index=times),
-            times,
-            pressure=atmosphere.alt2pres(location.altitude),
-        ).to_numpy(dtype=float)
-    dni_extra = irradiance.get_extra_radiation(times).to_numpy()
+        with _pvlib_reads_dayofyear():
+            dni = irradiance.dirint(
+                pd.Series(ghi, index=times),
+                pd.Series(zenith, index=times),
+                times,
+                pressure=atmosphere.alt2pres(location.altitude),
+            ).to_numpy(dtype=float)
+    dni_extra = extra_radiation(times)
     dni = np.clip(np.nan_to_num(dni, nan=0.0, posinf=0.0, neginf=0.0), 0.0, dni_extra)
     cos_zenith = np.clip(np.cos(np.radians(zenith)), 0.0, None)
     dhi = np.clip(ghi - dni * cos_zenith, 0.0, None)
@@ -181,7 +208,7 @@ def surface_irradiance(
     ghi, dni, dhi = (np.asarray(x, dtype=float) for x in (ghi, dni, dhi))
     extra = {}
     if sky_model in ("perez", "haydavies"):
-        extra["dni_extra"] = irradiance.get_extra_radiation(times).to_numpy()
+        extra["dni_extra"] = extra_radiation(times)
     if sky_model == "perez":
         extra["airmass"] = atmosphere.get_relative_airmass(zenith)
     poa = irradiance.get_total_irradiance(
@@ -404,9 +431,10 @@ def clear_sky_ghi(times: pd.DatetimeIndex, location: Location) -> np.ndarray:
         atmosphere.get_relative_airmass(position["apparent_zenith"].to_numpy()),
         atmosphere.alt2pres(location.altitude),
     )
-    turbidity = clearsky.lookup_linke_turbidity(
-        midpoints, location.latitude, location.longitude
-    ).to_numpy()
+    with _pvlib_reads_dayofyear():
+        turbidity = clearsky.lookup_linke_turbidity(
+            midpoints, location.latitude, location.longitude
+        ).to_numpy()
     # The night rows (air mass NaN) divide by zero inside pvlib; they are set to 0 below.
     with np.errstate(divide="ignore", invalid="ignore"):
         clear = clearsky.ineichen(
@@ -414,7 +442,7 @@ def clear_sky_ghi(times: pd.DatetimeIndex, location: Location) -> np.ndarray:
             airmass,
             turbidity,
             altitude=location.altitude,
-            dni_extra=irradiance.get_extra_radiation(midpoints).to_numpy(),
+            dni_extra=extra_radiation(midpoints),
         )["ghi"]
     return np.nan_to_num(np.asarray(clear, dtype=float), nan=0.0)
 
