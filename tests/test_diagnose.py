@@ -189,9 +189,9 @@ MANIFEST = {c["case"]: c for c in json.loads((VARIANTS / "manifest.json").read_t
 
 
 # The window variant's glazing is in no description (its JSON lists the facade as opaque wall):
-# found on the east facade, −21 % on the single split and −18 % on the folds' pooled test, but by
-# 0.084 K, under the 0.1 K margin (docs/diagnosis.md).
-UNDER_MARGIN = {"window_solar_gains"}
+# found first, on the east facade, but its final test RMSE is 0.79 × the baseline's, short of the
+# variants' 0.7 (−21 % on the single split, −18 % on the folds' pooled test; docs/diagnosis.md).
+SHORT_OF_RATIO = {"window_solar_gains"}
 
 
 @pytest.mark.slow
@@ -201,7 +201,7 @@ UNDER_MARGIN = {"window_solar_gains"}
         pytest.param(
             n,
             marks=pytest.mark.xfail(
-                n in UNDER_MARGIN, reason="found but under the 0.1 K margin", strict=True
+                n in SHORT_OF_RATIO, reason="found, but improves by less than 0.7×", strict=True
             ),
         )
         for n in sorted(MANIFEST)

@@ -68,9 +68,13 @@ def test_accepts_only_what_helps_in_most_folds():
     # seasonal coincidence, not physics.
     ok, why = judge_folds(_evidence([1, 1, 1, 1, 1, 3.0], [1.1, 1.1, 1.1, 1.1, 0.8, 0.5]), rule)
     assert not ok and "helps in 2 of 6 folds" in why
-    # Helps everywhere but by less than a sensor's accuracy.
-    ok, why = judge_folds(_evidence([0.5] * 6, [0.45] * 6), rule)
+    # Helps everywhere but by less than the relative margin.
+    ok, why = judge_folds(_evidence([0.5] * 6, [0.47] * 6), rule)
     assert not ok and "pooled test RMSE" in why and "folds" not in why
+    # Helps everywhere by 20 % but by less than 0.1 K: the folds judge recurrence, the kelvin
+    # margin is the single split's.
+    ok, why = judge_folds(_evidence([0.4] * 6, [0.32] * 6), rule)
+    assert ok and "helps in 6 of 6 folds" in why
 
 
 def test_confidence_is_a_sign_test():

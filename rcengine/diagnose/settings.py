@@ -45,8 +45,9 @@ class DiagnoseSettings:
     evidence: "folds" confirms an extension that passes the single split on rolling folds across
     the record (fold_train_days of training, the next fold_test_days tested, up to max_folds
     origins, each refitted with fold_preset from the fit on the training half; accepted when it
-    helps in more than min_fold_share of them and on the pooled test), "split" judges on the
-    single split alone."""
+    helps in more than min_fold_share of them and cuts the pooled test RMSE by min_improvement;
+    the kelvin margin is the single split's alone, see ``folds.FoldRule``), "split" judges on
+    the single split alone."""
 
     train_fraction: float = 0.5
     preset: str = "study"
@@ -70,8 +71,8 @@ class DiagnoseSettings:
 
     @property
     def fold_rule(self) -> FoldRule:
-        """The fold rule with this diagnosis's improvement margins."""
-        return FoldRule(self.min_fold_share, self.min_improvement, self.min_improvement_k)
+        """The fold rule with this diagnosis's relative improvement margin."""
+        return FoldRule(self.min_fold_share, self.min_improvement)
 
 
 def split_time(frame: pd.DataFrame, fraction: float, timezone: str) -> pd.Timestamp:
