@@ -1,6 +1,6 @@
 """What the dashboard shows, read through the repository and the forecaster the API uses.
 
-Fleet: one row per building (last upload, coverage, current set, last calibration, last day's
+Fleet: one row per building (last measured time, coverage, current set, last calibration, last day's
 forecast error, diagnosis verdict, badges). Building: the same summary, the series of the last
 days measured beside the day-ahead predictions, the next 24 h forecast with its interval, the
 last 30 days of data with their gaps, the parameter-set history, the jobs and the latest
