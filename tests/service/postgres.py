@@ -6,6 +6,7 @@ reached on its Unix socket only (it listens on no TCP address); one fresh databa
 from __future__ import annotations
 
 import itertools
+import os
 import tempfile
 from pathlib import Path
 
@@ -14,10 +15,23 @@ import psycopg
 _names = itertools.count(1)
 
 
+def _ensure_runtime_dir() -> None:
+    """pgserver keeps its lock in the user's runtime directory; a shell without a login session
+    (CI, containers) has no XDG_RUNTIME_DIR, and platformdirs then warns and falls back to
+    /tmp/runtime-<uid>. That same folder is named here, private to the user as the spec asks."""
+    if os.environ.get("XDG_RUNTIME_DIR"):
+        return
+    folder = Path(tempfile.gettempdir()) / f"runtime-{os.getuid()}"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    folder.chmod(0o700)  # the fallback may have made it earlier with the default mode
+    os.environ["XDG_RUNTIME_DIR"] = str(folder)
+
+
 class PostgresServer:
     """The session's server; ``create()`` a new empty database, ``drop()`` it again."""
 
     def __init__(self) -> None:
+        _ensure_runtime_dir()
         import pgserver  # imported here: only the tests that ask for PostgreSQL pay for it
 
         self.folder = Path(tempfile.mkdtemp(prefix="rcservice-pg-"))
