@@ -20,6 +20,7 @@ import pandas as pd
 from rcengine.columns import COLUMNS, Q_HVAC, T_IN
 from rcengine.metrics import rmse
 from rcengine.parameter_set import ParameterSet
+from rcengine.record import MIN_T_IN_STD_K, t_in_spread
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,7 @@ class GateLimits:
     """Where degenerate starts. [K, W, share]"""
 
     # Standard deviation of the measured t_in over the training rows below which it is flat.
-    min_t_in_std_k: float = 0.1
+    min_t_in_std_k: float = MIN_T_IN_STD_K
     # Range of q_hvac over the training rows below which the heating never changed.
     min_q_hvac_range_w: float = 1.0
     # Share of the free parameters on a bound above which the fit is pinned by its bounds.
@@ -92,7 +93,7 @@ def judge(
 
 
 def _t_in_varies(training: pd.DataFrame, limits: GateLimits) -> Check:
-    spread = float(np.nanstd(training[T_IN].to_numpy(dtype=float)))
+    spread = t_in_spread(training)
     return Check(
         "t_in_varies",
         spread >= limits.min_t_in_std_k,

@@ -58,6 +58,7 @@ from rcengine.diagnose.whiteness import ljung_box
 from rcengine.models import get_model
 from rcengine.network import RCNetwork
 from rcengine.parallel import one_blas_thread
+from rcengine.record import check_diagnosable
 from rcengine.signals import SignalOptions
 
 # A fold whose training window barely heats (or cools) cannot identify the model's response to
@@ -141,6 +142,7 @@ def _diagnose(
     started = time.perf_counter()
     timezone = building.location.timezone
     boundary = split_time(frame, settings.train_fraction, timezone)
+    check_diagnosable(frame, boundary)
     folds, left_out = [], []
     if settings.evidence == "folds":
         days = (settings.fold_train_days, settings.fold_test_days, settings.max_folds)

@@ -181,6 +181,16 @@ def test_failed_diagnosis_is_recorded_and_keeps_the_earlier_report(client, diagn
     ]
 
 
+def test_a_stuck_sensor_fails_the_diagnosis_with_its_reason(client, variant):
+    description, frame = variant
+    building_id, headers = measured_building(client, (description, frame.assign(t_in=21.0)))
+    job = diagnose(client, building_id, headers, effects=EFFECTS)
+    assert job["status"] == "failed"
+    assert "column 't_in'" in job["error"] and "stuck sensor" in job["error"]
+    assert job["diagnosis_id"] is None
+    assert report(client, building_id, headers).status_code == 404
+
+
 # --- the service around the engine -------------------------------------------------------------
 def test_no_report_before_a_diagnosis_is_404_with_what_to_do(client, variant):
     building_id, headers = register(client, variant[0])
