@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from rcengine.columns import T_IN
+from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, Problem
 
 # Standard deviation of the measured t_in below which the series is flat: a room sensor's
@@ -45,7 +46,7 @@ def check_diagnosable(frame: pd.DataFrame, boundary: pd.Timestamp) -> None:
                 "series is a stuck sensor",
             )
         )
-    step_s = float(np.median(np.diff(frame.index.as_unit("ns").asi8))) / 1e9
+    step_s = Dataset.from_frame(frame).step_s
     for side, rows in (("training", t_in.index < boundary), ("test", t_in.index >= boundary)):
         days = float(t_in[rows].notna().sum()) * step_s / 86400.0
         if days < MIN_MEASURED_DAYS:
