@@ -16,7 +16,8 @@ filtered y − C x⁺, which includes the row's own measurement); train open-loo
 (``Estimator.rmse_``); coverage of the 95 % interval ±1.96 ``t_in_std`` of 1-day-ahead forecasts
 (SYSLAB: consecutive 24 h forecasts from the test start; office: the predicted days). Output
 error has no noise model: its intervals use the filter's fixed defaults and are only nominal.
-The peers' figures are quoted as issue 12 records them; they are not measured here. Armadillo's
+The peers' figures are quoted as issue 12 records them; they are not measured here
+(pySIP's own, in an environment of its own: ``benchmarks/pysip_armadillo.py``). Armadillo's
 inputs are samples, which ``read_armadillo`` turns into the means over each step that the engine
 holds (see ``rcengine/io/measured.py``).
 
