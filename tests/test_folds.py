@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rcengine.diagnose.fitting import trust_region
+from rcengine.dataset import Dataset
+from rcengine.diagnose.fitting import Split, carried_on, split_data, trust_region
 from rcengine.diagnose.folds import (
     FoldEvidence,
     FoldRule,
@@ -14,7 +15,12 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
+from rcengine.diagnose.settings import split_time
+from rcengine.models import get_model
 from rcengine.network import Parameter, RCNetwork
+from rcengine.signals import SignalOptions
+
+from .synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
 
 TZ = "Europe/Rome"
 
@@ -105,3 +111,20 @@ def test_a_fold_refit_stays_near_the_fit_on_the_training_half():
     for name, (low, high) in region.items():
         p = net.parameters[name]
         assert p.lower <= low < high <= p.upper
+
+
+def test_the_test_period_is_simulated_on_from_training_without_its_measurements():
+    """The judged simulation carries the training period's state across the boundary: it
+    follows the reference through the test period and does not move when the test period's
+    measurements do (a restart would fit the unmeasured nodes' temperatures to them)."""
+    frame = weather_and_gains(21)
+    frame["t_in"] = basic_reference(frame, TRUTH_BASIC, (14.0, 20.0, 23.0))
+    network = get_model("basic", BUILDING, frame.columns)
+    boundary = split_time(frame, 0.5, BUILDING.location.timezone)
+    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
+    compiled = network.compile()
+    simulated = carried_on(compiled, TRUTH_BASIC, split)
+    assert np.max(np.abs(simulated - split.test.measured)) < 0.02
+    shifted = split.test.frame.assign(t_in=split.test.measured + 3.0)
+    moved = Split(split.train, Dataset(shifted, split.test.step_s))
+    assert np.array_equal(carried_on(compiled, TRUTH_BASIC, moved), simulated)

@@ -16,9 +16,9 @@ January is December and January) and the emitter (its dynamics show when the hea
 in milder weather). Diagnosed on October–January, these three are rejected.
 
 Two cases are expected to fail (``KNOWN``): on the record before their test week the diagnosis
-does not confirm window solar gains (fitted gain zero) nor sky radiation (−12 % on its test half,
-short of the margins); the full-season diagnosis (docs/diagnosis.md), which has seen the test
-weeks, finds both.
+confirms neither window solar gains (−12 %, 0.059 K on its test half) nor sky radiation (−11 %,
+0.069 K), short of the 0.1 K margin; the full-season diagnosis (docs/diagnosis.md), which has
+seen the test weeks, finds both.
 
 The diagnosis here is a single split with one baseline search (``engine_settings`` patched): what
 is tested is what adoption does with a diagnosis, not how thoroughly the diagnosis looks
