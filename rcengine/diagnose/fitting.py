@@ -109,13 +109,21 @@ class Fit:
 
 def innovations(compiled: CompiledNetwork, params: dict[str, float], data: Dataset) -> np.ndarray:
     """One-step-ahead Kalman errors over every segment (each restarted from its first value)."""
+    return _filtered(compiled, params, data, "innovations")
+
+
+def _filtered(
+    compiled: CompiledNetwork, params: dict[str, float], data: Dataset, field: str
+) -> np.ndarray:
+    """One row-wise ``FilterResult`` field of the Kalman filter run over every segment with a
+    measurement (each from its first value); NaN over the other segments."""
     model = compiled.discrete(params, data.step_s)
     u = data.inputs(compiled.input_names)
     y = data.measured
     out = np.full(len(data), np.nan)
     for seg in data.segments:
         if np.isfinite(y[seg]).any():
-            out[seg] = kalman_filter(model, u[seg], y[seg]).innovations
+            out[seg] = getattr(kalman_filter(model, u[seg], y[seg]), field)
     return out
 
 
@@ -163,13 +171,7 @@ def carried_on(compiled: CompiledNetwork, params: dict[str, float], split: Split
     (time updates only: an open-loop simulation from the filtered state). [°C]"""
     frames = [split.train.frame, split.test.frame.assign(**{T_IN: np.nan})]
     both = Dataset(pd.concat(frames), split.train.step_s)
-    model = compiled.discrete(params, both.step_s)
-    u, y = both.inputs(compiled.input_names), both.measured
-    predicted = np.full(len(both), np.nan)
-    for seg in both.segments:
-        if np.isfinite(y[seg]).any():
-            predicted[seg] = kalman_filter(model, u[seg], y[seg]).predicted
-    carried = predicted[len(split.train) :]
+    carried = _filtered(compiled, params, both, "predicted")[len(split.train) :]
     if np.isfinite(carried).all():
         return carried
     restarted = Objective(compiled, split.test).trajectory(params).y
