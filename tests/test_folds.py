@@ -23,6 +23,7 @@ from rcengine.signals import SignalOptions
 from .synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
 
 TZ = "Europe/Rome"
+DAY = pd.Timedelta(days=1)
 
 
 def _season(start: str = "2016-10-01", end: str = "2017-03-31") -> pd.DatetimeIndex:
@@ -128,3 +129,17 @@ def test_the_test_period_is_simulated_on_from_training_without_its_measurements(
     shifted = split.test.frame.assign(t_in=split.test.measured + 3.0)
     moved = Split(split.train, Dataset(shifted, split.test.step_s))
     assert np.array_equal(carried_on(compiled, TRUTH_BASIC, moved), simulated)
+
+
+def test_a_test_period_after_a_gap_in_the_record_is_restarted_from_its_own_first_rows():
+    """No state crosses a gap: the test rows after one are simulated from their own start, and
+    every test row gets a value."""
+    frame = weather_and_gains(21)
+    frame["t_in"] = basic_reference(frame, TRUTH_BASIC, (14.0, 20.0, 23.0))
+    boundary = split_time(frame, 0.5, BUILDING.location.timezone)
+    frame = frame.drop(frame.index[(frame.index >= boundary) & (frame.index < boundary + DAY)])
+    network = get_model("basic", BUILDING, frame.columns)
+    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
+    simulated = carried_on(network.compile(), TRUTH_BASIC, split)
+    assert np.isfinite(simulated).all()
+    assert np.max(np.abs(simulated - split.test.measured)) < 0.02

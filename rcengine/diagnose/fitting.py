@@ -168,7 +168,13 @@ def fit_model(
 def carried_on(compiled: CompiledNetwork, params: dict[str, float], split: Split) -> np.ndarray:
     """The test period forecast from the state the training measurements give: the Kalman
     filter run over the training rows, then on over the test rows without their measurements
-    (time updates only: an open-loop simulation from the filtered state). [°C]"""
+    (time updates only: an open-loop simulation from the filtered state). [°C]
+
+    Restarted at the boundary with its unmeasured initial temperatures fitted to the test
+    measurements, a candidate with one more slow node (a thermal mass, an emitter) would get one
+    more value fitted to the data it is judged on. Test rows after a gap in the record (a new
+    segment, no state to carry across) are still restarted that way, from their own rows.
+    """
     frames = [split.train.frame, split.test.frame.assign(**{T_IN: np.nan})]
     both = Dataset(pd.concat(frames), split.train.step_s)
     carried = _filtered(compiled, params, both, "predicted")[len(split.train) :]
