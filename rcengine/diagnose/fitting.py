@@ -10,7 +10,6 @@ import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
-from rcengine.columns import T_IN
 from rcengine.dataset import Dataset
 from rcengine.diagnose.folds import Fold
 from rcengine.estimation.estimator import Estimator
@@ -22,6 +21,7 @@ from rcengine.metrics import rmse
 from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.parallel import can_start_processes, process_pool
 from rcengine.signals import SignalOptions, prepare
+from rcengine.simulate import simulate
 
 # A fold's refit stays within this factor of the fit on the training half (``trust_region``). [-]
 TRUST_FACTOR = 3.0
@@ -109,21 +109,13 @@ class Fit:
 
 def innovations(compiled: CompiledNetwork, params: dict[str, float], data: Dataset) -> np.ndarray:
     """One-step-ahead Kalman errors over every segment (each restarted from its first value)."""
-    return _filtered(compiled, params, data, "innovations")
-
-
-def _filtered(
-    compiled: CompiledNetwork, params: dict[str, float], data: Dataset, field: str
-) -> np.ndarray:
-    """One row-wise ``FilterResult`` field of the Kalman filter run over every segment with a
-    measurement (each from its first value); NaN over the other segments."""
     model = compiled.discrete(params, data.step_s)
     u = data.inputs(compiled.input_names)
     y = data.measured
     out = np.full(len(data), np.nan)
     for seg in data.segments:
         if np.isfinite(y[seg]).any():
-            out[seg] = getattr(kalman_filter(model, u[seg], y[seg]), field)
+            out[seg] = kalman_filter(model, u[seg], y[seg]).innovations
     return out
 
 
@@ -175,12 +167,21 @@ def carried_on(compiled: CompiledNetwork, params: dict[str, float], split: Split
     more value fitted to the data it is judged on. Test rows after a gap in the record (a new
     segment, no state to carry across) are still restarted that way, from their own rows.
     """
-    frames = [split.train.frame, split.test.frame.assign(**{T_IN: np.nan})]
-    both = Dataset(pd.concat(frames), split.train.step_s)
-    carried = _filtered(compiled, params, both, "predicted")[len(split.train) :]
+    train, test = split.train, split.test
+    last, first = train.segments[-1], test.segments[0]
+    carried = np.full(len(test), np.nan)
+    y_last = train.measured[last]
+    adjoining = test.times[0] - train.times[last.stop - 1] == pd.Timedelta(seconds=train.step_s)
+    if adjoining and np.isfinite(y_last).any():
+        model = compiled.discrete(params, train.step_s)
+        u_last = train.inputs(compiled.input_names)[last]
+        boundary_state = kalman_filter(model, u_last, y_last).state
+        rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
+        u_first = test.inputs(compiled.input_names)[first]
+        carried[first] = simulate(rc, u_first, boundary_state[None], test.step_s)[0]
     if np.isfinite(carried).all():
         return carried
-    restarted = Objective(compiled, split.test).trajectory(params).y
+    restarted = Objective(compiled, test).trajectory(params).y
     return np.where(np.isfinite(carried), carried, restarted)
 
 
