@@ -90,6 +90,8 @@ def records() -> dict[str, tuple[pd.DataFrame, int]]:
     df = pd.read_csv(DATA / "armadillo_data_H2.csv").set_index("Time")
     df = df.drop(df.index[-1])
     df.index = df.index / S_PER_DAY
+    # rcengine.io.measured.read_armadillo's step means, written out: this script runs where pySIP is
+    # installed, not the engine.
     means = df.copy()
     for column in INPUTS:
         samples = means[column].to_numpy()
