@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -15,6 +17,8 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
+from rcengine.diagnose.report import Finding
+from rcengine.diagnose.selection import _one_version_each
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
 from rcengine.network import Parameter, RCNetwork
@@ -96,6 +100,35 @@ def test_head_to_head_names_the_winner_and_the_margin():
     assert winner == 0
     assert "better in 1 of 4 folds" in why
     assert head_to_head(weak, strong)[0] == 1
+
+
+def _version(effect: str, schedule: str, sse_train: float, after: float) -> Finding:
+    return Finding(
+        effect,
+        True,
+        1,
+        0.0,
+        "projection",
+        1.0,
+        1.0,
+        detail={"schedule": schedule},
+        fit=SimpleNamespace(sse_train=sse_train),
+        evidence=_evidence([1.0] * 5, [after] * 5),
+    )
+
+
+def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
+    # The refined schedule fits the training period better but forecasts the folds worse.
+    first = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 2.0, 0.8)
+    other = _version("wind_infiltration", "", 1.0, 0.7)
+    refined = _version("unmetered_gains", "Mon–Fri 07:00–17:00", 1.0, 0.9)
+    chosen = _one_version_each([first, other, refined])
+    assert chosen == [first, other]
+    assert first.detail["schedule_not_taken"] == "Mon–Fri 07:00–17:00 (0.900 K)"
+    # A version the folds reject loses to one they accept, whatever its pooled test.
+    first, refined = (_version("unmetered_gains", s, 1.0, 0.8) for s in ("a", "b"))
+    first.accepted = False
+    assert _one_version_each([first, refined]) == [refined]
 
 
 def test_a_fold_refit_stays_near_the_fit_on_the_training_half():

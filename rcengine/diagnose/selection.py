@@ -373,15 +373,17 @@ def _context(problem: Problem, current: Fit) -> Context:
 
 def _refine(
     problem: Problem, current: Fit, extensions: list[Extension], fits: list[Fit]
-) -> tuple[list[Extension], list[Fit]]:
-    """Re-learn the shape of learnt inputs (schedules) from each refit and refit once more.
+) -> list[tuple[int, Extension, Fit]]:
+    """Re-learn the shape of learnt inputs (schedules) from each refit and refit once more;
+    returns the refined versions as (index of the first version, extension, fit).
 
     The first schedule is learnt from the current model's residual, whose parameters had bent to
     absorb part of the missing effect; after a refit the model is closer to the truth and the
-    residual shows the effect's shape more fully. The refined version is kept if it fits better.
+    residual shows the effect's shape more fully. A better training fit does not make it the
+    better version: the refit's new basin can fit the training weeks more closely and forecast
+    worse (``_versions`` chooses).
     """
     settings = problem.settings
-    extensions, fits = list(extensions), list(fits)
     jobs, where = [], []
     for i, (ext, fit) in enumerate(zip(extensions, fits, strict=True)):
         if not ext.learnt:
@@ -413,10 +415,44 @@ def _refine(
         where.append((i, refined))
     if jobs:
         problem.say(f"  refining the learnt shape of {', '.join(r.effect for _, r in where)}")
-    for (i, refined), fit in zip(where, fit_many(jobs, settings.workers), strict=True):
-        if fit.sse_train < fits[i].sse_train:
-            extensions[i], fits[i] = refined, fit
-    return extensions, fits
+    refits = fit_many(jobs, settings.workers)
+    return [(i, refined, fit) for (i, refined), fit in zip(where, refits, strict=True)]
+
+
+def _versions(
+    problem: Problem, extensions: list[Extension], fits: list[Fit], refined: list[tuple]
+) -> list[tuple[Extension, Fit]]:
+    """The versions of each extension to judge: with folds, the first and the refined one (the
+    folds choose, ``_one_version_each``); without, the one that fits the training period better."""
+    versions = list(zip(extensions, fits, strict=True))
+    for i, ext, fit in refined:
+        if problem.folds:
+            versions.append((ext, fit))
+        elif fit.sse_train < fits[i].sse_train:
+            versions[i] = (ext, fit)
+    return versions
+
+
+def _one_version_each(findings: list[Finding]) -> list[Finding]:
+    """Per effect, the version the folds favour: accepted before rejected, then the lower pooled
+    test RMSE across the folds, then the better training fit; the other is named in its detail."""
+
+    def rank(f: Finding) -> tuple[bool, float, float]:
+        pooled = f.evidence.pooled_after if f.evidence is not None else float("inf")
+        return (not f.accepted, pooled, f.fit.sse_train)
+
+    chosen: dict[str, Finding] = {}
+    for f in findings:
+        other = chosen.get(f.effect)
+        if other is None:
+            chosen[f.effect] = f
+            continue
+        best, worse = sorted((other, f), key=rank)
+        if worse.evidence is not None and "schedule" in worse.detail:
+            pooled = worse.evidence.pooled_after
+            best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+        chosen[f.effect] = best
+    return list(chosen.values())
 
 
 def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> Finding | None:
@@ -439,13 +475,13 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     refit = ranked[:n_refit]
     problem.say(f"  refitting {', '.join(e.effect for e in refit)}")
     fits = _refits(problem, current, refit, splits)
-    refit, fits = _refine(problem, current, refit, fits)
+    versions = _versions(problem, refit, fits, _refine(problem, current, refit, fits))
     confirmed = [
-        _judge(problem, e, current, fit, screens[e.effect], round_no)
-        for e, fit in zip(refit, fits, strict=True)
+        _judge(problem, e, current, fit, screens[e.effect], round_no) for e, fit in versions
     ]
     if problem.folds:
-        _confirm_on_folds(problem, state, refit, confirmed)
+        _confirm_on_folds(problem, state, [e for e, _ in versions], confirmed)
+        confirmed = _one_version_each(confirmed)
     for ext in ranked[n_refit:]:
         state.verdicts[ext.effect] = screened_only(ext, current, screens[ext.effect], round_no)
     for finding in confirmed:
