@@ -51,6 +51,10 @@ def test_weekly_profile_round_trip_and_description():
     np.testing.assert_allclose(profile, truth + 0.01)
     np.testing.assert_array_equal(on_hours(profile), truth)
     assert describe(truth) == "Mon–Fri 08:00–18:00"
+    # Two blocks in a day are two blocks in words, not one span over the hours between.
+    saturday = truth.copy()
+    saturday[5 * 24 + 2 : 5 * 24 + 6] = saturday[5 * 24 + 18 : 6 * 24] = 1.0
+    assert describe(saturday) == "Mon–Fri 08:00–18:00, Sat 02:00–06:00 & 18:00–24:00"
     np.testing.assert_array_equal(on_hours(-np.ones(72)), np.zeros(72))
     with pytest.raises(ValueError, match="168"):
         schedule_signal(np.ones(24), times, "UTC")

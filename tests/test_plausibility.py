@@ -46,14 +46,15 @@ SMALL = office(
 )
 
 
-def _context(sign: float) -> Context:
+def _context(sign: float, days: tuple[int, ...] = (0, 1, 2, 3, 4)) -> Context:
     """Two weeks of the small office on the basic model at TRUTH_BASIC, its residual the response
-    to ``sign`` × 2 kW on weekday mornings (a gain for +1; a loss, on cold days, for −1)."""
+    to ``sign`` × 2 kW on the mornings of ``days`` (Monday 0; a gain for +1; a loss, on cold
+    days, for −1). Occupants are metered on weekdays 08:00–18:00."""
     frame = weather_and_gains(14).assign(wind_speed=3.0)
     network = get_model("basic", SMALL, frame.columns)
     data = prepare(frame.assign(t_in=20.0), SMALL, network.compile().input_names)
     local = data.times.tz_convert(SMALL.location.timezone)
-    mornings = (local.day_of_week < 5) & (local.hour >= 8) & (local.hour < 12)
+    mornings = np.isin(local.day_of_week, days) & (local.hour >= 8) & (local.hour < 12)
     residual = node_responses(network, TRUTH_BASIC, data, "air", sign * 2000.0 * mornings)[:, 0]
     return Context(network, SMALL, data, SignalOptions(), TRUTH_BASIC, residual)
 
@@ -170,6 +171,22 @@ def test_an_impossible_fit_is_rejected_with_its_reason(effect, gain_context, los
     assert any(case.reason in p for p in rejected.problems), rejected.problems
     for magnitude in rejected.magnitudes.values():
         assert set(magnitude) == {"value", "unit", "meaning"} and np.isfinite(magnitude["value"])
+
+
+def test_a_gain_scheduled_when_nobody_is_in_is_rejected(gain_context):
+    """Equipment and people come with the occupants: a weekend "gain" in an office whose
+    occupants are metered on weekdays only is the model answering for something else."""
+    weekdays = CANDIDATES["unmetered_gains"](gain_context)
+    assert weekdays.detail["occupied_share"] > weekdays.detail["occupied_share_all"]
+    assert assess(weekdays, {**TRUTH_BASIC, "q_unmetered": 10.0}).plausible
+    weekend = CANDIDATES["unmetered_gains"](_context(1.0, days=(5, 6)))
+    assert weekend.detail["schedule"].startswith("Sat") and weekend.detail["occupied_share"] == 0.0
+    rejected = assess(weekend, {**TRUTH_BASIC, "q_unmetered": 10.0})
+    share = weekend.detail["occupied_share_all"]
+    assert rejected.problems == [
+        "share of the gain's scheduled hours with occupants metered (q_occ > 0): 0 is below any "
+        f"gain the occupants bring (≥ {share:.3g})"
+    ]
 
 
 def test_implausibly_small_magnitudes_are_rejected_too(gain_context):

@@ -24,6 +24,7 @@ from rcengine.building import Building
 from rcengine.columns import (
     GAINS_SCHEDULE,
     Q_HVAC,
+    Q_OCC,
     SCHED_GAINS,
     SKY_DELTA,
     SOLAR_OPAQUE,
@@ -69,6 +70,7 @@ from rcengine.signals.schedules import (
     clock_zone,
     day_type_hour,
     describe,
+    hour_of_week,
     on_hours,
     weekly_from_day_types,
 )
@@ -535,8 +537,24 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
         "unmetered internal heat (equipment, people) in the scheduled hours, per m² of floor",
     )
     heat = (SCHED_GAINS, ctx.network.output)
-    ext = _with_gain(ctx, effect, q_unmetered, heat, {"floor_area_m2": floor}, floor)
+    detail = {"floor_area_m2": floor, **occupied_shares(ctx, learnt)}
+    ext = _with_gain(ctx, effect, q_unmetered, heat, detail, floor)
     return _on_schedule(ext, GAINS_SCHEDULE, learnt)
+
+
+def occupied_shares(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
+    """Shares of the training rows in which occupants are metered (``q_occ`` > 0): of those on
+    the ``learnt`` schedule (``occupied_share``) and of all (``occupied_share_all``) [-]; empty
+    without a ``q_occ`` column, or when it meters no occupant."""
+    if Q_OCC not in ctx.train.columns:
+        return {}
+    occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
+    zone = clock_zone(ctx.building.location.timezone, learnt.clock)
+    on = learnt.schedule[hour_of_week(ctx.data.times, zone)] > 0.0
+    if not occupied.any() or not on.any():
+        return {}
+    share, share_all = float(occupied[on].mean()), float(occupied.mean())
+    return {"occupied_share": share, "occupied_share_all": share_all}
 
 
 def ground_coupling(ctx: Context) -> Extension | Skipped:

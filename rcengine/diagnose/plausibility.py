@@ -243,7 +243,26 @@ def _unmetered(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             f"unmetered internal gain in the scheduled hours, per m² of floor ({q * floor:.0f} W)",
             UNMETERED_W_M2,
             "occupied floor",
-        )
+        ),
+        *_occupied(ext.detail),
+    ]
+
+
+def _occupied(detail: Mapping) -> list[Reading]:
+    """The gain's schedule against the metered occupancy, when there is one.
+
+    Equipment and people come and go with the occupants (the plug-load and occupancy schedules
+    of EN 16798-1 Annex C and ASHRAE 90.1 rise and fall together); what runs in empty hours is a
+    base load, constant, not a weekly pattern. So the gain's scheduled hours must hold occupants
+    more often than the building's hours do on average. A "gain" switched on no more often when
+    people are in is the model answering for something else: heat that a setback's cooling
+    draws from a mass the model lacks, or a heater's recovery."""
+    if "occupied_share" not in detail:
+        return []
+    share, average = detail["occupied_share"], detail["occupied_share_all"]
+    meaning = "share of the gain's scheduled hours with occupants metered (q_occ > 0)"
+    return [
+        Reading("occupied_share", share, "-", meaning, (average, 1.0), "gain the occupants bring")
     ]
 
 

@@ -83,12 +83,10 @@ def on_hours(profile: np.ndarray, fraction: float = 0.5) -> np.ndarray:
 
 
 def describe(schedule: np.ndarray) -> str:
-    """Plain words for a 0/1 weekly schedule, e.g. "weekdays 08:00–18:00"."""
+    """Plain words for a 0/1 weekly schedule, e.g. "Mon–Fri 08:00–18:00", each day's separate
+    blocks joined by "&" ("Sat 02:00–06:00 & 18:00–24:00")."""
     days = ["Mon", "Tue", "Wed", "Thu", "Fri", "Sat", "Sun"]
-    spans = []
-    for d in range(7):
-        hours = np.flatnonzero(schedule[d * 24 : (d + 1) * 24] > 0.5)
-        spans.append(f"{hours[0]:02d}:00–{hours[-1] + 1:02d}:00" if hours.size else None)
+    spans = [_blocks(np.asarray(schedule[d * 24 : (d + 1) * 24]) > 0.5) for d in range(7)]
     groups: list[tuple[list[str], str]] = []
     for day, span in zip(days, spans, strict=True):
         if span is None:
@@ -103,3 +101,12 @@ def describe(schedule: np.ndarray) -> str:
     return ", ".join(
         f"{g[0]}–{g[-1]} {span}" if len(g) > 1 else f"{g[0]} {span}" for g, span in groups
     )
+
+
+def _blocks(on: np.ndarray) -> str | None:
+    """ "08:00–12:00 & 13:00–18:00" for the on-hours of one day (24,), None if there are none."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], on, [False]]).astype(int)))
+    if not edges.size:
+        return None
+    starts, ends = edges[::2], edges[1::2]
+    return " & ".join(f"{a:02d}:00–{b:02d}:00" for a, b in zip(starts, ends, strict=True))
