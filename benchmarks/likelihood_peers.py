@@ -19,7 +19,9 @@ error has no noise model: its intervals use the filter's fixed defaults and are 
 The peers' figures are quoted as issue 12 records them; they are not measured here
 (pySIP's own, in an environment of its own: ``benchmarks/pysip_armadillo.py``). Armadillo's
 inputs are samples, which ``read_armadillo`` turns into the means over each step that the engine
-holds (see ``rcengine/io/measured.py``).
+holds (see ``rcengine/io/measured.py``); it is also run on the samples themselves under a
+first-order hold (``Dataset(hold="foh")``, linear between samples), as pySIP's example runs it
+(``armadillo_first_order_hold`` in the JSON line).
 
     python benchmarks/likelihood_peers.py [--repeats 7] [--every 7]
 
@@ -33,6 +35,7 @@ import json
 import os
 import time
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the other benchmarks
@@ -78,17 +81,21 @@ PEERS_RECORDED = {
 }
 
 
-def measured_case(name: str, heater: bool = False) -> tuple[RCNetwork, Dataset, int]:
-    """The network, the record and the number of training rows of a measured building."""
+def measured_case(
+    name: str, heater: bool = False, hold: str = "zoh"
+) -> tuple[RCNetwork, Dataset, int]:
+    """The network, the record and the number of training rows of a measured building; Armadillo
+    with ``hold="foh"``: its inputs as the samples recorded, linear in between."""
     building = Building.from_json(BUILDINGS / f"{name}.json")
     if name == "armadillo":
-        frame = read_armadillo(MEASURED / "armadillo_data_H2.csv").iloc[:232]
+        inputs = "samples" if hold == "foh" else "means"
+        frame = read_armadillo(MEASURED / "armadillo_data_H2.csv", inputs=inputs).iloc[:232]
     else:
         frame = read_syslab(MEASURED / "syslab_inputPRBS1.csv")
     net = get_model("2r2c", building, frame.columns)
     if heater:
         net = with_heater(net, building.floor_area)
-    data = prepare(frame, building, net.compile().input_names)
+    data = replace(prepare(frame, building, net.compile().input_names), hold=hold)
     return net, data, 162 if name == "armadillo" else len(data) * 2 // 3
 
 
@@ -126,7 +133,7 @@ def timed_fit(
 
 def one_step_rmse(est: Estimator, data: Dataset, rows: slice) -> float:
     """RMSE of the filter's one-step predictions over ``rows``, the filter run from the start."""
-    model = est.compiled.discrete(est.params_, data.step_s)
+    model = est.compiled.discrete(est.params_, data.step_s, data.hold)
     noise = est.noise_
     kwargs = {}
     if noise is not None:
@@ -159,9 +166,9 @@ def coverage(predicted: np.ndarray, measured: np.ndarray, std: np.ndarray) -> fl
     return float(np.mean(np.abs(measured[ok] - predicted[ok]) <= 1.96 * std[ok]))
 
 
-def measured_report(name: str, repeats: int, heater: bool = False) -> dict:
+def measured_report(name: str, repeats: int, heater: bool = False, hold: str = "zoh") -> dict:
     """Both criteria on one measured building, the issue's split."""
-    net, data, n_train = measured_case(name, heater)
+    net, data, n_train = measured_case(name, heater, hold)
     train, start = data.between(None, data.times[n_train]), data.times[n_train]
     test = slice(n_train, None)
     hours = (len(data) - n_train) * data.step_s / 3600.0
@@ -229,10 +236,12 @@ def main() -> None:
     parser.add_argument("--every", type=int, default=7, help="office: every n-th study day")
     args = parser.parse_args()
     armadillo = measured_report("armadillo", args.repeats)
+    armadillo_foh = measured_report("armadillo", args.repeats, hold="foh")
     syslab = measured_report("syslab", max(1, args.repeats // 3))
     syslab_heater = measured_report("syslab", 1, heater=True)
     office = office_report(args.every)
     print_table("Armadillo (162 rows train, 70 test, 2r2c without sun)", armadillo)
+    print_table("Armadillo, samples under first-order hold (as pySIP's example)", armadillo_foh)
     print_table("SYSLAB (2/3 train, 2r2c)", syslab)
     print_table("SYSLAB (2/3 train, 2r2c+heater)", syslab_heater)
     cases = (
@@ -266,6 +275,10 @@ def main() -> None:
         "syslab_heater_test_open_loop_K": round(
             syslab_heater["likelihood"]["test_open_loop_K"], 4
         ),
+        "armadillo_first_order_hold": {
+            key: round(armadillo_foh["likelihood"][key], 5)
+            for key in ("test_open_loop_K", "test_one_step_K", "fit_s_median")
+        },
         "coverage_95": {
             "office": round(office["likelihood"]["coverage_95_1day"], 4),
             "syslab": round(syslab["likelihood"]["coverage_95_1day"], 4),

@@ -17,6 +17,7 @@ import pandas as pd
 from rcengine.columns import T_IN
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.instants import parse_instant
+from rcengine.statespace import HOLDS
 
 
 @dataclass(frozen=True)
@@ -25,13 +26,23 @@ class Dataset:
 
     frame : contract columns plus any derived signals (e.g. ``solar_window``). [SI units]
     step_s : the regular step. [s]
+    hold : how the inputs run between rows: ``"zoh"``, each row's value held over its interval
+        (the contract's means over the step, the default), or ``"foh"``, samples at the stamps
+        with the signal linear in between (``rcengine.simulate``).
     """
 
     frame: pd.DataFrame
     step_s: float
+    hold: str = "zoh"
+
+    def __post_init__(self) -> None:
+        if self.hold not in HOLDS:
+            raise ModelError(f"unknown input hold {self.hold!r}; choose one of {HOLDS}")
 
     @classmethod
-    def from_frame(cls, frame: pd.DataFrame, step_s: float | None = None) -> Dataset:
+    def from_frame(
+        cls, frame: pd.DataFrame, step_s: float | None = None, hold: str = "zoh"
+    ) -> Dataset:
         if not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
             raise DataValidationError([Problem(None, "time", "index must be tz-aware times")])
         if len(frame) < 2:
@@ -40,7 +51,7 @@ class Dataset:
             raise DataValidationError([Problem(None, "time", "times must strictly increase")])
         if step_s is None:
             step_s = float(pd.Series(_step_seconds(frame.index)).mode().iloc[0])
-        return cls(frame.tz_convert("UTC"), float(step_s))
+        return cls(frame.tz_convert("UTC"), float(step_s), hold)
 
     # --- structure ----------------------------------------------------------------------------
     @property
@@ -79,12 +90,13 @@ class Dataset:
 
     def with_columns(self, extra: pd.DataFrame) -> Dataset:
         """The same rows with more columns (derived signals), aligned on time."""
-        return Dataset(self.frame.join(extra, how="left", suffixes=("", "_derived")), self.step_s)
+        joined = self.frame.join(extra, how="left", suffixes=("", "_derived"))
+        return Dataset(joined, self.step_s, self.hold)
 
     def _subset(self, mask: np.ndarray) -> Dataset:
         if not mask.any():
             raise DataValidationError([Problem(None, "time", "no rows in the selected period")])
-        return Dataset(self.frame.loc[mask], self.step_s)
+        return Dataset(self.frame.loc[mask], self.step_s, self.hold)
 
     # --- arrays -------------------------------------------------------------------------------
     def inputs(self, names: Sequence[str]) -> np.ndarray:

@@ -77,7 +77,7 @@ def initial_state(
                 )
             ]
         )
-    history = Dataset(past, data.step_s)
+    history = Dataset(past, data.step_s, data.hold)
     last = history.segments[-1]
     rows = history.frame.iloc[last]
     measured = rows["t_in"].to_numpy(dtype=float) if "t_in" in rows else np.array([np.nan])
@@ -85,7 +85,7 @@ def initial_state(
         raise DataValidationError(
             [Problem(None, "t_in", f"no measured t_in in the {history_h:g} h before {start}")]
         )
-    u = Dataset(rows, data.step_s).inputs(model.input_names)
+    u = Dataset(rows, data.step_s, data.hold).inputs(model.input_names)
     return kalman_filter(
         model, u, measured, process_cov=process_cov, measurement_std=measurement_std
     )
@@ -140,7 +140,7 @@ def forecast(
     steps = round(hours * 3600.0 / data.step_s)
     if steps < 1:
         raise ModelError(f"forecast horizon {hours} h is shorter than one step")
-    model = network.discrete(params, data.step_s)
+    model = network.discrete(params, data.step_s, data.hold)
     if noise is None:
         filtered = initial_state(model, data, start, history_h)
     else:

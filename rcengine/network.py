@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rcengine.exceptions import ModelError
-from rcengine.statespace import DiscreteStateSpace, discretize
+from rcengine.statespace import HOLDS, DiscreteStateSpace, discretize, discretize_foh
 
 Value = str | float  # a parameter name, or a fixed number in SI units
 
@@ -383,11 +383,20 @@ class CompiledNetwork:
         B = rc.F / rc.capacity[:, :, None]
         return A, B, rc.c, rc.d
 
-    def discrete(self, params: dict[str, float] | np.ndarray, dt: float) -> DiscreteStateSpace:
-        """Exact zero-order-hold model of one parameter set at step ``dt`` [s], for embedding."""
-        A, B, C, D = self.state_space(self.as_theta(params)[:1])
-        Ad, Bd = discretize(A[0], B[0], dt)
-        return DiscreteStateSpace(Ad, Bd, C[0], D[0], float(dt), self.state_names, self.input_names)
+    def discrete(
+        self, params: dict[str, float] | np.ndarray, dt: float, hold: str = "zoh"
+    ) -> DiscreteStateSpace:
+        """Exact model of one parameter set at step ``dt`` [s], for embedding: the inputs held
+        over each step (``"zoh"``) or linear between samples (``"foh"``, whose state is shifted
+        by the ramp's response, ``statespace.discretize_foh``)."""
+        A, B, C, D = (a[0] for a in self.state_space(self.as_theta(params)[:1]))
+        if hold == "foh":
+            Ad, Bd, D, _ = discretize_foh(A, B, C, D, dt)
+        elif hold == "zoh":
+            Ad, Bd = discretize(A, B, dt)
+        else:
+            raise ModelError(f"unknown input hold {hold!r}; choose one of {HOLDS}")
+        return DiscreteStateSpace(Ad, Bd, C, D, float(dt), self.state_names, self.input_names)
 
 
 @dataclass(frozen=True)

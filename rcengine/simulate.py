@@ -11,6 +11,15 @@ and the zero-order hold over dt is exact per mode (the same discretisation as
 
     z_i[k+1] = a_i z_i[k] + b_i g_iᵀ u[k],   a_i = e^{−λ_i dt},  b_i = (1 − a_i)/λ_i.
 
+Inputs sampled at the stamps and linear in between (first-order hold, ``hold="foh"``) add the
+ramp's response r_i = ∫₀^dt e^{−λ_i(dt−s)} s/dt ds = (1 − b_i/dt)/λ_i:
+
+    z_i[k+1] = a_i z_i[k] + (b_i − r_i) g_iᵀ u[k] + r_i g_iᵀ u[k+1].
+
+In the state z̃ = z − r·Gu (Franklin, Powell & Workman, *Digital Control*, §6.3.2) this is again
+a recursion in u[k] alone, with the input map (b − r + a·r)·G and the output
+y = cᵀz̃ + (d + Σ_i c_i r_i g_i)ᵀ u: the same simulator runs either hold.
+
 The time recursion is then one multiply-add per mode and step, vectorised over a population of
 parameter sets; its cost is independent of the number of inputs.
 """
@@ -22,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rcengine.network import RCMatrices
+from rcengine.statespace import HOLDS
 
 # Elements of a (steps × population × modes) work block; bounds memory for long series.
 _BLOCK_ELEMENTS = 100_000
@@ -38,7 +48,9 @@ class ModalSystem:
 
     decay (S,n) = a;  input_map (S,n,m) = diag(b)·G;  to_modal (S,n,n) maps T → z;
     output (S,n) maps z → y;  feedthrough (S,m) = d;  valid (S,) false where the set is
-    not a passive, finite system (its outputs are NaN and its cost infinite).
+    not a passive, finite system (its outputs are NaN and its cost infinite). First-order hold:
+    input_map and feedthrough as in the module doc, and ramp_map (S,n,m) = diag(r)·G, the shift
+    of the state z̃ = z − r·Gu.
     """
 
     decay: np.ndarray
@@ -47,18 +59,26 @@ class ModalSystem:
     output: np.ndarray
     feedthrough: np.ndarray
     valid: np.ndarray
+    ramp_map: np.ndarray | None = None
 
     @property
     def size(self) -> int:
         return self.decay.shape[0]
 
-    def modal_state(self, temperatures: np.ndarray) -> np.ndarray:
-        """Node temperatures (S,n) → modal states (S,n)."""
-        return np.einsum("sij,sj->si", self.to_modal, temperatures)
+    def modal_state(self, temperatures: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        """Node temperatures (S,n) → modal states (S,n); under first-order hold the recursion's
+        state z̃ = z − r·Gu, which needs the inputs u (m,) of that instant."""
+        z = np.einsum("sij,sj->si", self.to_modal, temperatures)
+        if self.ramp_map is not None and u is not None:
+            z = z - self.ramp_map @ np.asarray(u, dtype=float)
+        return z
 
 
-def modal_system(rc: RCMatrices, dt: float) -> ModalSystem:
-    """Discretise a population of RC systems exactly (zero-order hold) in modal form."""
+def modal_system(rc: RCMatrices, dt: float, hold: str = "zoh") -> ModalSystem:
+    """Discretise a population of RC systems exactly in modal form, the inputs held over each
+    step (``"zoh"``, the contract's rows) or linear between samples (``"foh"``, module doc)."""
+    if hold not in HOLDS:
+        raise ValueError(f"unknown input hold {hold!r}; choose one of {HOLDS}")
     capacity = rc.capacity
     finite = (
         np.isfinite(capacity).all(1)
@@ -78,12 +98,25 @@ def modal_system(rc: RCMatrices, dt: float) -> ModalSystem:
     lam = np.maximum(lam, 0.0)
     decay = np.exp(-lam * dt)
     with np.errstate(divide="ignore", invalid="ignore"):
-        hold = np.where(lam * dt > 1e-12, -np.expm1(-lam * dt) / lam, dt)
+        b = np.where(lam * dt > 1e-12, -np.expm1(-lam * dt) / lam, dt)
     QT = np.swapaxes(Q, 1, 2)
-    input_map = hold[:, :, None] * (QT @ (scale[:, :, None] * F))
+    G = QT @ (scale[:, :, None] * F)
     to_modal = QT * np.sqrt(safe_cap)[:, None, :]
     output = np.einsum("sj,sji->si", rc.c * scale, Q)
-    return ModalSystem(decay, input_map, to_modal, output, rc.d, valid)
+    if hold == "zoh":
+        return ModalSystem(decay, b[:, :, None] * G, to_modal, output, rc.d, valid)
+    ramp = _ramp(lam, b, dt)
+    input_map = (b - ramp + decay * ramp)[:, :, None] * G
+    feedthrough = rc.d + np.einsum("si,sim->sm", output * ramp, G)
+    return ModalSystem(decay, input_map, to_modal, output, feedthrough, valid, ramp[:, :, None] * G)
+
+
+def _ramp(lam: np.ndarray, b: np.ndarray, dt: float) -> np.ndarray:
+    """r = ∫₀^dt e^{−λ(dt−s)} s/dt ds = (1 − b/dt)/λ [s]; its series dt·(½ − λdt/6) where the
+    difference would cancel."""
+    x = lam * dt
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(x > 1e-4, (1.0 - b / dt) / lam, dt * (0.5 - x / 6.0))
 
 
 def simulate_modal(system: ModalSystem, u: np.ndarray, z0: np.ndarray) -> np.ndarray:
@@ -182,7 +215,9 @@ def free_response(system: ModalSystem, steps: int, nodes: list[int]) -> np.ndarr
     return np.swapaxes(out, 1, 2)
 
 
-def simulate(rc: RCMatrices, u: np.ndarray, x0: np.ndarray, dt: float) -> np.ndarray:
+def simulate(
+    rc: RCMatrices, u: np.ndarray, x0: np.ndarray, dt: float, hold: str = "zoh"
+) -> np.ndarray:
     """Simulate a population of RC systems from node temperatures x0 (S, n) over u (T, m).
 
     Parameters
@@ -192,11 +227,13 @@ def simulate(rc: RCMatrices, u: np.ndarray, x0: np.ndarray, dt: float) -> np.nda
         [°C for temperatures, W or W/m² for flows]
     x0 : initial node temperatures. [°C]
     dt : step. [s]
+    hold : "zoh" (inputs held over each step) or "foh" (samples, linear in between).
 
     Returns
     -------
     y : (S, T) output temperature at the start of each step. [°C]
     """
-    system = modal_system(rc, dt)
+    u = np.asarray(u, dtype=float)
+    system = modal_system(rc, dt, hold)
     x0 = np.broadcast_to(np.asarray(x0, dtype=float), system.decay.shape)
-    return simulate_modal(system, u, system.modal_state(x0))
+    return simulate_modal(system, u, system.modal_state(x0, u[0]))

@@ -1,4 +1,5 @@
-"""Discrete-time state-space systems: the one zero-order-hold discretisation of the engine.
+"""Discrete-time state-space systems: the engine's exact discretisations (zero- and first-order
+hold, ``discretize`` and ``discretize_foh``; with noise, ``discretize_stochastic``).
 
 With the input held constant over a step of length dt (zero-order hold), the exact solution of
 ẋ = A x + B u is
@@ -16,6 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
+
+# How inputs run between samples: held over each step (zero-order hold, the contract's rows) or
+# linear between samples (first-order hold).
+HOLDS = ("zoh", "foh")
 
 
 def discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -40,6 +45,32 @@ def discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.
     M[..., :n, n:] = B * dt
     E = scipy.linalg.expm(M)
     return E[..., :n, :n], E[..., :n, n:]
+
+
+def discretize_foh(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Exact first-order-hold discretisation (inputs sampled, linear between samples), in the
+    form x̃[k+1] = A_d x̃[k] + B̃ u[k], y[k] = C x̃[k] + D̃ u[k] of one parameter set.
+
+    With Γ₀ the zero-order hold's B_d and Γ₁ = ∫₀^dt e^{A(dt−s)} B s/dt ds the response to the
+    ramp, x[k+1] = A_d x[k] + (Γ₀ − Γ₁) u[k] + Γ₁ u[k+1]; in the state x̃ = x − Γ₁ u,
+    B̃ = Γ₀ − Γ₁ + A_d Γ₁ and D̃ = D + C Γ₁ (Franklin, Powell & Workman, *Digital Control of
+    Dynamic Systems*, §6.3.2). All three blocks come from one exponential:
+
+        exp( [[A, B, 0], [0, 0, I/dt], [0, 0, 0]] · dt ) = [[A_d, Γ₀, Γ₁], [0, I, I], [0, 0, I]].
+
+    Parameters: A (n, n) [1/s], B (n, m), C (n,), D (m,), dt [s]. Returns A_d, B̃ (n, m), D̃ (m,)
+    and Γ₁ (n, m), which maps a physical state to the recursion's: x̃ = x − Γ₁ u.
+    """
+    n, m = A.shape[0], B.shape[1]
+    M = np.zeros((n + 2 * m, n + 2 * m))
+    M[:n, :n] = A * dt
+    M[:n, n : n + m] = B * dt
+    M[n : n + m, n + m :] = np.eye(m)
+    E = scipy.linalg.expm(M)
+    A_d, gamma0, gamma1 = E[:n, :n], E[:n, n : n + m], E[:n, n + m :]
+    return A_d, gamma0 - gamma1 + A_d @ gamma1, D + C @ gamma1, gamma1
 
 
 def discretize_stochastic(

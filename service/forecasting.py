@@ -203,7 +203,7 @@ class Forecaster:
         data = loaded.pset.prepare(mask_measured(frame, at))
         model = self._discrete.get_or_compute(
             (key.set_id, data.step_s),
-            lambda: loaded.compiled.discrete(loaded.pset.values, data.step_s),
+            lambda: loaded.compiled.discrete(loaded.pset.values, data.step_s, data.hold),
         )
         filtered = initial_state(model, data, at, self.history_h)
         return ModelState(

@@ -21,7 +21,7 @@ from rcengine.metrics import rmse
 from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.parallel import can_start_processes, process_pool
 from rcengine.signals import SignalOptions, prepare
-from rcengine.simulate import simulate
+from rcengine.simulate import modal_system, simulate_modal
 
 # A fold's refit stays within this factor of the fit on the training half (``trust_region``). [-]
 TRUST_FACTOR = 3.0
@@ -109,7 +109,7 @@ class Fit:
 
 def innovations(compiled: CompiledNetwork, params: dict[str, float], data: Dataset) -> np.ndarray:
     """One-step-ahead Kalman errors over every segment (each restarted from its first value)."""
-    model = compiled.discrete(params, data.step_s)
+    model = compiled.discrete(params, data.step_s, data.hold)
     u = data.inputs(compiled.input_names)
     y = data.measured
     out = np.full(len(data), np.nan)
@@ -173,12 +173,15 @@ def carried_on(compiled: CompiledNetwork, params: dict[str, float], split: Split
     y_last = train.measured[last]
     adjoining = test.times[0] - train.times[last.stop - 1] == pd.Timedelta(seconds=train.step_s)
     if adjoining and np.isfinite(y_last).any():
-        model = compiled.discrete(params, train.step_s)
+        model = compiled.discrete(params, train.step_s, train.hold)
         u_last = train.inputs(compiled.input_names)[last]
         boundary_state = kalman_filter(model, u_last, y_last).state
         rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
+        system = modal_system(rc, test.step_s, test.hold)
         u_first = test.inputs(compiled.input_names)[first]
-        carried[first] = simulate(rc, u_first, boundary_state[None], test.step_s)[0]
+        # The filter's state is the recursion's own (shifted under first-order hold, like z̃).
+        z0 = system.modal_state(boundary_state[None])
+        carried[first] = simulate_modal(system, u_first, z0)[0]
     if np.isfinite(carried).all():
         return carried
     restarted = Objective(compiled, test).trajectory(params).y

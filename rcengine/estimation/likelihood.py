@@ -212,17 +212,19 @@ class Evaluation:
 
 
 def discretize_modal(
-    rc: RCMatrices, process_std: np.ndarray, dt: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """A_d, B_d, Q_d as :func:`rcengine.statespace.discretize_stochastic` gives them, and which
-    sets are valid, from the modes of the RC systems (:func:`rcengine.simulate.modal_system`).
+    rc: RCMatrices, process_std: np.ndarray, dt: float, hold: str = "zoh"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A_d, B_d, Q_d as :func:`rcengine.statespace.discretize_stochastic` gives them, which
+    sets are valid, and the feedthrough D, from the modes of the RC systems
+    (:func:`rcengine.simulate.modal_system`; under first-order hold B_d and D are those of the
+    shifted state, which leaves the noise as it is).
 
     With z = W T the modes decouple (rates λ_i, a_i = e^{−λ_i dt}); a noise of intensity
     Σ_z = W Σ Wᵀ, Σ = diag(σ_w²)/3600, gathers (Σ_z)_ij (1 − a_i a_j)/(λ_i + λ_j) over one step.
     No exponential of a stiff matrix, and ~5× cheaper than Van Loan's. process_std (S, n)
     [K/√h]; dt [s]. Invalid sets (not finite, not passive) get a harmless stand-in system.
     """
-    modes = modal_system(rc, dt)
+    modes = modal_system(rc, dt, hold)
     W = modes.to_modal
     capacity = np.where(modes.valid[:, None], rc.capacity, 1.0)
     to_nodes = np.swapaxes(W / capacity[:, None, :], 1, 2)  # W⁻¹ = C^{-1/2} Q
@@ -236,7 +238,7 @@ def discretize_modal(
     Q = to_nodes @ (sigma_z * gathered) @ np.swapaxes(to_nodes, 1, 2)
     A_d = (to_nodes * modes.decay[:, None, :]) @ W
     B_d = to_nodes @ modes.input_map
-    return A_d, B_d, 0.5 * (Q + np.swapaxes(Q, 1, 2)), modes.valid
+    return A_d, B_d, 0.5 * (Q + np.swapaxes(Q, 1, 2)), modes.valid, modes.feedthrough
 
 
 class LikelihoodObjective:
@@ -252,7 +254,7 @@ class LikelihoodObjective:
         if initial not in INITIAL:
             raise ModelError(f"invalid initial {initial!r}; choose from {INITIAL}")
         self.network, self.space, self.initial = network, space, initial
-        self.step_s = data.step_s
+        self.step_s, self.hold = data.step_s, data.hold
         u, y = data.inputs(network.input_names), data.measured
         self.segments = [(u[s], y[s]) for s in data.segments if np.isfinite(y[s]).any()]
         self.n_obs = int(np.isfinite(y).sum())
@@ -264,9 +266,9 @@ class LikelihoodObjective:
         theta, process_std, measurement_std = self.space.split(z)
         self.n_evaluations += theta.shape[0]
         rc = self.network.rc_matrices(theta)
-        A_d, B_d, Q, valid = discretize_modal(rc, process_std, self.step_s)
+        A_d, B_d, Q, valid, D = discretize_modal(rc, process_std, self.step_s, self.hold)
         n = A_d.shape[1]
-        C, D = np.where(valid[:, None], rc.c, 0.0), np.where(valid[:, None], rc.d, 0.0)
+        C, D = np.where(valid[:, None], rc.c, 0.0), np.where(valid[:, None], D, 0.0)
         P0 = Q if self.initial == "estimated" else np.zeros_like(Q)
         parts = [
             self._segment(A_d, B_d, C, D, Q, measurement_std**2, P0, u, y) for u, y in self.segments

@@ -73,7 +73,7 @@ class Objective:
         if cost not in COSTS:
             raise ValueError(f"invalid cost {cost!r}; choose from {COSTS}")
         self.network = network
-        self.step_s = data.step_s
+        self.step_s, self.hold = data.step_s, data.hold
         self.cost = cost
         u = data.inputs(network.input_names)
         y = data.measured
@@ -104,7 +104,7 @@ class Objective:
         """Measured − simulated at every measured row (S, n_obs); NaN for an invalid set."""
         theta = self.network.as_theta(theta)
         self.n_evaluations += theta.shape[0]
-        system = modal_system(self.network.rc_matrices(theta), self.step_s)
+        system = modal_system(self.network.rc_matrices(theta), self.step_s, self.hold)
         parts = []
         for seg in self.segments:
             y_fit, _ = self._fit_segment(system, seg)
@@ -119,7 +119,7 @@ class Objective:
         y0 = seg.y[seg.mask][0] if seg.mask.any() else float(np.nan)
         prior = np.full((S, n), y0)
         profiled = self._profiled_nodes(seg)
-        y_forced = simulate_modal(system, seg.u, system.modal_state(prior))
+        y_forced = simulate_modal(system, seg.u, system.modal_state(prior, seg.u[0]))
         if not profiled or not seg.mask.any():
             return y_forced, prior
         sensitivity = free_response(system, seg.u.shape[0], profiled)
@@ -149,7 +149,7 @@ class Objective:
     def trajectory(self, theta: np.ndarray | dict) -> Trajectory:
         """Simulated output over every row of the data, with the profiled initial states."""
         theta = self.network.as_theta(theta)[:1]
-        system = modal_system(self.network.rc_matrices(theta), self.step_s)
+        system = modal_system(self.network.rc_matrices(theta), self.step_s, self.hold)
         y = np.full(self.n_rows, np.nan)
         states = []
         for seg in self.segments:

@@ -114,7 +114,9 @@ def read_syslab(path: str | Path, start: str | pd.Timestamp = SYSLAB_START) -> p
     )
 
 
-def read_armadillo(path: str | Path, start: str | pd.Timestamp = ARMADILLO_START) -> pd.DataFrame:
+def read_armadillo(
+    path: str | Path, start: str | pd.Timestamp = ARMADILLO_START, inputs: str = "means"
+) -> pd.DataFrame:
     """Armadillo Box experiment as a contract frame (``t_in``, ``t_out``, ``ghi``, ``q_hvac``).
 
     Parameters
@@ -122,23 +124,28 @@ def read_armadillo(path: str | Path, start: str | pd.Timestamp = ARMADILLO_START
     path : ``armadillo_data_H2.csv``.
     start : instant of ``Time = 0``, with a UTC offset (a placeholder date by default, see the
         module docstring).
+    inputs : ``"means"`` (default): ``t_out``, ``ghi`` and ``q_hvac`` are the means over
+        [t_k, t_k+1) of the linearly interpolated samples, (s_k + s_k+1)/2, the last row's
+        samples held — the contract's rows, for a zero-order hold; ``"samples"``: the samples at
+        the stamps as recorded, for a first-order hold (``Dataset(hold="foh")``).
 
     Returns
     -------
-    Validated frame on a UTC index, 30-minute rows. ``t_out``, ``ghi`` (``I_sol`` taken as
-    horizontal) and ``q_hvac``: the means over [t_k, t_k+1) of the linearly interpolated samples,
-    (s_k + s_k+1)/2, the last row's samples held; ``t_in``: the sample at t (module docstring).
-    [°C, W/m², W]
+    Validated frame on a UTC index, 30-minute rows; ``ghi`` is ``I_sol`` taken as horizontal;
+    ``t_in`` is the sample at t (module docstring). [°C, W/m², W]
     """
+    if inputs not in ("means", "samples"):
+        raise ValueError(f"inputs must be 'means' or 'samples', not {inputs!r}")
     raw = pd.read_csv(path)
+    held = _interval_means if inputs == "means" else (lambda samples: samples)
     return _contract_frame(
         start,
         raw["Time"].to_numpy(float),
         {
             T_IN: raw["T_int"],
-            T_OUT: _interval_means(raw["T_ext"]),
-            GHI: _interval_means(raw["I_sol"]),
-            Q_HVAC: _interval_means(raw["P_hea"]),
+            T_OUT: held(raw["T_ext"]),
+            GHI: held(raw["I_sol"]),
+            Q_HVAC: held(raw["P_hea"]),
         },
     )
 
