@@ -21,6 +21,7 @@ import json
 import sys
 import warnings
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, NoReturn
 
@@ -40,6 +41,7 @@ from rcengine.models.spec import ModelSpec, check_columns
 from rcengine.network import RCNetwork
 from rcengine.parameter_set import ParameterSet
 from rcengine.signals import SignalOptions, prepare
+from rcengine.statespace import HOLDS
 
 app = typer.Typer(
     help="Grey-box RC thermal models of buildings: calibrate, forecast, diagnose.",
@@ -116,10 +118,19 @@ def fit(
     criterion: Annotated[
         str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
     ] = "output_error",
+    input_hold: Annotated[
+        str,
+        typer.Option(
+            help="zoh: each row's inputs are means over its step (the contract); foh: samples at "
+            "the stamps, linear in between (kept in the parameter file for predict)"
+        ),
+    ] = "zoh",
 ) -> None:
     """Calibrate MODEL (or the model of --model-file) on DATA and write the parameter set."""
 
     _check(check_criterion, criterion)
+    if input_hold not in HOLDS:
+        fail(f"--input-hold must be one of {' | '.join(HOLDS)}, not {input_hold!r}")
     if (model is None) == (model_file is None):
         fail("give either --model or --model-file")
 
@@ -128,6 +139,7 @@ def fit(
         first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
         name, net, options = _model_to_fit(model, model_file, b, frame, sky_model)
+        options = replace(options, input_hold=input_hold)
         dataset = prepare(frame, b, net.compile().input_names, options).between(first, last)
         if weekdays:
             dataset = dataset.weekdays(b.location.timezone)

@@ -4,6 +4,7 @@ residual checks, prediction intervals, and the Armadillo box."""
 
 from __future__ import annotations
 
+import json
 import warnings
 from functools import cache
 
@@ -452,3 +453,26 @@ def test_cli_fit_by_likelihood_and_predict_with_std(armadillo, project_data, tmp
     result = runner.invoke(app, ["fit", str(csv), "-b", str(building), "-m", "2r2c",
                                  "--criterion", "ml", "-o", str(params)])  # fmt: skip
     assert result.exit_code == 2 and "invalid criterion 'ml'" in result.output
+
+
+def test_cli_fits_samples_under_first_order_hold_and_predict_keeps_it(
+    shared_data, project_data, tmp_path
+):
+    frame = read_armadillo(shared_data / "measured" / "armadillo_data_H2.csv", inputs="samples")
+    csv, params, out = tmp_path / "samples.csv", tmp_path / "params.json", tmp_path / "fc.csv"
+    rows = frame.iloc[:232].rename_axis("time").reset_index()
+    rows["time"] = rows["time"].dt.strftime("%Y-%m-%dT%H:%M:%S+00:00")
+    rows.to_csv(csv, index=False)
+    building = project_data / "measured" / "armadillo.json"
+    end = frame.index[162].isoformat()
+    fit_args = ["fit", str(csv), "-b", str(building), "-m", "2r2c", "--end", end, "-o", str(params)]
+    runner = CliRunner()
+    result = runner.invoke(app, [*fit_args, "--input-hold", "foh"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(params.read_text())["signals"]["input_hold"] == "foh"
+    result = runner.invoke(app, ["predict", str(csv), "-p", str(params), "--start", end,
+                                 "--hours", "6", "-o", str(out)])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert len(pd.read_csv(out)) == 12
+    result = runner.invoke(app, [*fit_args, "--input-hold", "linear"])
+    assert result.exit_code == 2 and "--input-hold must be one of zoh | foh" in result.output

@@ -48,7 +48,8 @@ class SignalOptions:
     (168 hourly values) by name; schedule_clock: "local" (civil time, daylight saving) or
     "standard" (standard time all year) for playing them back; ground_cycle: the outdoor annual
     cycle under ``t_ground`` (``AnnualCycle.to_dict``), fixed once fitted, else fitted to the
-    frame at hand (``signals.ground``).
+    frame at hand (``signals.ground``); input_hold: "zoh" (the contract's rows, means over their
+    step) or "foh" (inputs recorded as samples, linear in between), ``Dataset.hold``.
     """
 
     sky_model: str = "isotropic"
@@ -58,6 +59,7 @@ class SignalOptions:
     schedules: dict[str, list[float]] = field(default_factory=dict)
     schedule_clock: str = "local"
     ground_cycle: dict[str, float | str] | None = None
+    input_hold: str = "zoh"
 
     def schedule_zone(self, building: Building) -> Zone:
         return clock_zone(building.location.timezone, self.schedule_clock)
@@ -212,5 +214,5 @@ def prepare(
     """Dataset holding the contract columns plus every derived signal in ``inputs``."""
     options = options or SignalOptions()
     extra = derive(frame, building, inputs, options)
-    data = Dataset.from_frame(frame, step_s)
+    data = Dataset.from_frame(frame, step_s, options.input_hold)
     return data.with_columns(extra) if len(extra.columns) else data
