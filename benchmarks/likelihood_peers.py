@@ -35,7 +35,6 @@ import json
 import os
 import time
 import warnings
-from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the other benchmarks
@@ -55,7 +54,7 @@ from rcengine.kalman import kalman_filter
 from rcengine.metrics import rmse
 from rcengine.models import get_model
 from rcengine.network import Parameter, RCNetwork
-from rcengine.signals import prepare
+from rcengine.signals import SignalOptions, prepare
 
 ROOT = Path(__file__).resolve().parents[1]
 MEASURED = ROOT.parent / "shared" / "data" / "measured"
@@ -95,7 +94,7 @@ def measured_case(
     net = get_model("2r2c", building, frame.columns)
     if heater:
         net = with_heater(net, building.floor_area)
-    data = replace(prepare(frame, building, net.compile().input_names), hold=hold)
+    data = prepare(frame, building, net.compile().input_names, SignalOptions(input_hold=hold))
     return net, data, 162 if name == "armadillo" else len(data) * 2 // 3
 
 

@@ -104,7 +104,7 @@ def describe(schedule: np.ndarray) -> str:
 
 
 def _blocks(on: np.ndarray) -> str | None:
-    """ "08:00–12:00 & 13:00–18:00" for the on-hours of one day (24,), None if there are none."""
+    """The on-hours of one day (24,) in words, e.g. "08:00–12:00 & 13:00–18:00"; None if none."""
     edges = np.flatnonzero(np.diff(np.concatenate([[False], on, [False]]).astype(int)))
     if not edges.size:
         return None
