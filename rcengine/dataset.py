@@ -17,7 +17,7 @@ import pandas as pd
 from rcengine.columns import T_IN
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.instants import parse_instant
-from rcengine.statespace import HOLDS
+from rcengine.statespace import check_hold
 
 
 @dataclass(frozen=True)
@@ -36,8 +36,7 @@ class Dataset:
     hold: str = "zoh"
 
     def __post_init__(self) -> None:
-        if self.hold not in HOLDS:
-            raise ModelError(f"unknown input hold {self.hold!r}; choose one of {HOLDS}")
+        check_hold(self.hold)
 
     @classmethod
     def from_frame(

@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rcengine.exceptions import ModelError
-from rcengine.statespace import HOLDS, DiscreteStateSpace, discretize, discretize_foh
+from rcengine.statespace import DiscreteStateSpace, check_hold, discretize, discretize_foh
 
 Value = str | float  # a parameter name, or a fixed number in SI units
 
@@ -390,12 +390,10 @@ class CompiledNetwork:
         over each step (``"zoh"``) or linear between samples (``"foh"``, whose state is shifted
         by the ramp's response, ``statespace.discretize_foh``)."""
         A, B, C, D = (a[0] for a in self.state_space(self.as_theta(params)[:1]))
-        if hold == "foh":
+        if check_hold(hold) == "foh":
             Ad, Bd, D, _ = discretize_foh(A, B, C, D, dt)
-        elif hold == "zoh":
-            Ad, Bd = discretize(A, B, dt)
         else:
-            raise ModelError(f"unknown input hold {hold!r}; choose one of {HOLDS}")
+            Ad, Bd = discretize(A, B, dt)
         return DiscreteStateSpace(Ad, Bd, C, D, float(dt), self.state_names, self.input_names)
 
 

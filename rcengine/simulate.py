@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rcengine.network import RCMatrices
-from rcengine.statespace import HOLDS
+from rcengine.statespace import check_hold
 
 # Elements of a (steps × population × modes) work block; bounds memory for long series.
 _BLOCK_ELEMENTS = 100_000
@@ -77,8 +77,7 @@ class ModalSystem:
 def modal_system(rc: RCMatrices, dt: float, hold: str = "zoh") -> ModalSystem:
     """Discretise a population of RC systems exactly in modal form, the inputs held over each
     step (``"zoh"``, the contract's rows) or linear between samples (``"foh"``, module doc)."""
-    if hold not in HOLDS:
-        raise ValueError(f"unknown input hold {hold!r}; choose one of {HOLDS}")
+    check_hold(hold)
     capacity = rc.capacity
     finite = (
         np.isfinite(capacity).all(1)

@@ -18,9 +18,18 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from rcengine.exceptions import ModelError
+
 # How inputs run between samples: held over each step (zero-order hold, the contract's rows) or
 # linear between samples (first-order hold).
 HOLDS = ("zoh", "foh")
+
+
+def check_hold(hold: str) -> str:
+    """``hold`` if it is one of :data:`HOLDS`; else ModelError naming the choices."""
+    if hold not in HOLDS:
+        raise ModelError(f"unknown input hold {hold!r}; choose one of {HOLDS}")
+    return hold
 
 
 def discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
