@@ -13,6 +13,7 @@ from rcengine.signals.derived import SignalOptions, derive, derivers, mask_measu
 from rcengine.signals.ground import ground_temperature
 from rcengine.signals.schedules import (
     clock_zone,
+    closed_weekdays,
     describe,
     hour_of_week,
     on_hours,
@@ -58,6 +59,58 @@ def test_weekly_profile_round_trip_and_description():
     np.testing.assert_array_equal(on_hours(-np.ones(72)), np.zeros(72))
     with pytest.raises(ValueError, match="168"):
         schedule_signal(np.ones(24), times, "UTC")
+
+
+def _office_weeks(weeks: int) -> pd.DataFrame:
+    """``weeks`` of 15-min rows from Monday 2017-01-09 (Rome) with 5 kW of occupants on
+    weekdays 08:00–18:00 and none otherwise."""
+    times = pd.date_range("2017-01-09", periods=weeks * 7 * 96, freq="15min", tz="Europe/Rome")
+    office_hours = (times.day_of_week < 5) & (times.hour >= 8) & (times.hour < 18)
+    return pd.DataFrame({"q_occ": np.where(office_hours, 5000.0, 0.0)}, index=times)
+
+
+def test_a_weekday_without_occupants_runs_the_sunday_schedule():
+    frame = _office_weeks(3)
+    local = frame.index.tz_convert("Europe/Rome")
+    holiday = local.normalize() == pd.Timestamp("2017-01-18", tz="Europe/Rome")  # a Wednesday
+    frame.loc[holiday, "q_occ"] = 0.0
+    frame.loc[holiday & (local.hour == 10), "q_occ"] = 300.0  # a cleaner is not the office
+    closed = closed_weekdays(frame, "Europe/Rome")
+    np.testing.assert_array_equal(closed, holiday)
+    weekdays_on = np.zeros(168)
+    for day in range(5):
+        weekdays_on[day * 24 + 8 : day * 24 + 18] = 1.0
+    weekdays_on[6 * 24 + 10] = 0.5  # Sunday 10:00
+    played = schedule_signal(weekdays_on, frame.index, "Europe/Rome", closed)
+    assert played[holiday & (local.hour == 9)].max() == 0.0
+    assert (played[holiday & (local.hour == 10)] == 0.5).all()
+    np.testing.assert_array_equal(
+        played[~holiday], schedule_signal(weekdays_on, frame.index[~holiday], "Europe/Rome")
+    )
+    # The derived schedule signal plays the closure too.
+    building = Building.from_dict(
+        {
+            "name": "b",
+            "location": {"latitude": 45.0, "longitude": 7.7, "timezone": "Europe/Rome"},
+            "floor_area": 100.0,
+            "volume": 300.0,
+            "wall_area": 120.0,
+        }
+    )
+    options = SignalOptions(schedules={"gains": weekdays_on.tolist()})
+    signal = derive(frame, building, [schedule_signal_name("gains")], options)
+    np.testing.assert_array_equal(signal[schedule_signal_name("gains")].to_numpy(), played)
+
+
+def test_occupancy_that_does_not_tell_the_days_apart_closes_no_day():
+    frame = _office_weeks(2)
+    assert not closed_weekdays(frame.drop(columns="q_occ"), "Europe/Rome").any()
+    assert not closed_weekdays(frame.assign(q_occ=0.0), "Europe/Rome").any()
+    local = frame.index.tz_convert("Europe/Rome")
+    mostly_empty = frame.assign(q_occ=np.where(local.day_of_week == 0, frame["q_occ"], 0.0))
+    assert not closed_weekdays(mostly_empty, "Europe/Rome").any()
+    unmetered = frame.assign(q_occ=np.where(local.day_of_week == 2, np.nan, frame["q_occ"]))
+    assert not closed_weekdays(unmetered, "Europe/Rome").any()
 
 
 def test_ground_temperature_is_a_slow_running_mean():

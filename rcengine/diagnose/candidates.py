@@ -68,6 +68,7 @@ from rcengine.signals.schedules import (
     CLOCKS,
     N_DAY_TYPES,
     clock_zone,
+    closed_weekdays,
     day_type_hour,
     describe,
     hour_of_week,
@@ -369,11 +370,17 @@ class LearntSchedule:
     schedule: np.ndarray
     clock: str
     explained: float
+    closed_days: int = 0  # weekdays of the training period without occupants, on Sunday's hours
 
     @property
     def words(self) -> str:
         clock = "" if self.clock == "local" else ", standard time all year (no daylight saving)"
-        return f"{describe(self.schedule)}{clock}"
+        closed = (
+            f"; {self.closed_days} weekdays without occupants on Sunday's hours"
+            if self.closed_days
+            else ""
+        )
+        return f"{describe(self.schedule)}{clock}{closed}"
 
 
 def _learnt_schedule(
@@ -414,8 +421,11 @@ def _clocks(ctx: Context) -> tuple[str, ...]:
     if ctx.signals.schedules:
         return (ctx.signals.schedule_clock,)
     tz = ctx.building.location.timezone
-    standard = day_type_hour(ctx.data.times, clock_zone(tz, "standard"))
-    return ("local",) if np.array_equal(day_type_hour(ctx.data.times, tz), standard) else CLOCKS
+    zones = [clock_zone(tz, clock) for clock in CLOCKS]
+    local, standard = (
+        day_type_hour(ctx.data.times, z, closed_weekdays(ctx.train, z)) for z in zones
+    )
+    return ("local",) if np.array_equal(local, standard) else CLOCKS
 
 
 def _schedule_on_clock(
@@ -438,7 +448,8 @@ def _schedule_on_clock(
     """
     data = ctx.data
     zone = clock_zone(ctx.building.location.timezone, clock)
-    hour = day_type_hour(data.times, zone)
+    closed = closed_weekdays(data.frame, zone)
+    hour = day_type_hour(data.times, zone, closed)
     heat = np.zeros((len(data), N_DAY_TYPES * 24))
     heat[np.arange(len(data)), hour] = per_unit
     # A weekly schedule is a pattern that repeats: a day type seen on one date only (the single
@@ -465,7 +476,8 @@ def _schedule_on_clock(
     explained = on_off_explainer(residual, responses, ctx.sensitivities)
     start = max((on_hours(profile, share) * allowed for share in ON_SHARES), key=explained)
     best = _move_edges(start, explained) * allowed
-    return LearntSchedule(weekly_from_day_types(best), clock, explained(best))
+    closed_days = data.times[closed].tz_convert(zone).normalize().nunique()
+    return LearntSchedule(weekly_from_day_types(best), clock, explained(best), closed_days)
 
 
 def _move_edges(
@@ -550,7 +562,8 @@ def occupied_shares(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
         return {}
     occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
     zone = clock_zone(ctx.building.location.timezone, learnt.clock)
-    on = learnt.schedule[hour_of_week(ctx.data.times, zone)] > 0.0
+    closed = closed_weekdays(ctx.train, zone)
+    on = learnt.schedule[hour_of_week(ctx.data.times, zone, closed)] > 0.0
     if not occupied.any() or not on.any():
         return {}
     share, share_all = float(occupied[on].mean()), float(occupied.mean())

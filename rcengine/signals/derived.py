@@ -30,7 +30,7 @@ from rcengine.columns import (
 from rcengine.dataset import Dataset
 from rcengine.exceptions import ModelError
 from rcengine.signals.ground import AnnualCycle, seasonal_ground_temperature
-from rcengine.signals.schedules import Zone, clock_zone, schedule_signal
+from rcengine.signals.schedules import Zone, clock_zone, closed_weekdays, schedule_signal
 from rcengine.signals.solar import solar_gains, solar_signal_names
 
 # Indoor temperature of the air-exchange losses where none was measured before (and none after):
@@ -124,8 +124,9 @@ def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) 
     if VENT_SCHEDULE not in options.schedules:
         raise ModelError(f"signal '{VENT_LOSS}' needs a '{VENT_SCHEDULE}' schedule")
     t_out = frame[T_OUT].to_numpy(dtype=float)
+    zone = options.schedule_zone(building)
     schedule = schedule_signal(
-        options.schedules[VENT_SCHEDULE], frame.index, options.schedule_zone(building)
+        options.schedules[VENT_SCHEDULE], frame.index, zone, closed_weekdays(frame, zone)
     )
     loss = schedule * (t_out - indoor_operating_point(frame))
     return pd.DataFrame({VENT_LOSS: loss}, index=frame.index)
@@ -134,9 +135,10 @@ def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) 
 def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
     """sched_<name>: a stored weekly schedule played back on its clock. [-]"""
     tz = options.schedule_zone(building)
+    closed = closed_weekdays(frame, tz)
     return pd.DataFrame(
         {
-            schedule_signal_name(name): schedule_signal(p, frame.index, tz)
+            schedule_signal_name(name): schedule_signal(p, frame.index, tz, closed)
             for name, p in options.schedules.items()
         },
         index=frame.index,

@@ -6,6 +6,11 @@ the residuals with that weekly rhythm, so a schedule is the natural shape for su
 A schedule runs on one of two clocks: "local", the civil time of the building's zone with its
 daylight-saving shifts, or "standard", the zone's standard time all year round — how controllers
 that ignore daylight saving (and EnergyPlus runs without a daylight-saving period) keep time.
+
+A weekday on which the metered occupancy shows nobody in (a holiday, a closure) runs the Sunday
+profile, as building schedules run holidays (EnergyPlus's "Sunday Holidays" day types, the
+closed-day profiles of EN 16798-1 Annex C): equipment and ventilation follow the occupants, and
+a weekday pattern played through an empty fortnight would be the model's own invention.
 """
 
 from __future__ import annotations
@@ -15,7 +20,10 @@ import datetime as dt
 import numpy as np
 import pandas as pd
 
+from rcengine.columns import Q_OCC
+
 HOURS_PER_WEEK = 168
+SUNDAY = 6
 CLOCKS = ("local", "standard")
 Zone = str | dt.tzinfo
 
@@ -31,10 +39,42 @@ def clock_zone(timezone: str, clock: str) -> Zone:
     return dt.timezone(min(offsets))
 
 
-def hour_of_week(times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
-    """0 = Monday 00:00–01:00 local time … 167 = Sunday 23:00–24:00."""
+# A weekday is closed when its largest metered occupant heat is below this share of a typical
+# weekday's largest (the median over the weekdays): a cleaner or a guard is not the office. [-]
+CLOSED_DAY_SHARE = 0.1
+
+
+def closed_weekdays(frame: pd.DataFrame, timezone: Zone) -> np.ndarray:
+    """Rows (bool, len(frame)) on a Monday–Friday date whose metered occupant heat ``q_occ``
+    stays under ``CLOSED_DAY_SHARE`` of a typical weekday's: the building is closed. None are
+    without ``q_occ`` (or on dates it was not metered), nor when most weekdays would be closed:
+    then the column does not tell the office's days apart."""
+    closed = np.zeros(len(frame), dtype=bool)
+    if Q_OCC not in frame.columns:
+        return closed
+    local = frame.index.tz_convert(timezone)
+    q = pd.Series(frame[Q_OCC].to_numpy(dtype=float), index=local.normalize())
+    weekday = pd.Series(local.day_of_week < 5, index=q.index).groupby(level=0).first()
+    peaks = q.groupby(level=0).max()[weekday]
+    peaks = peaks[np.isfinite(peaks)]
+    if peaks.empty or not peaks.median() > 0.0:
+        return closed
+    shut = peaks.index[peaks < CLOSED_DAY_SHARE * peaks.median()]
+    if len(shut) > 0.5 * len(peaks):
+        return closed
+    return np.asarray(q.index.isin(shut))
+
+
+def hour_of_week(
+    times: pd.DatetimeIndex, timezone: Zone, closed: np.ndarray | None = None
+) -> np.ndarray:
+    """0 = Monday 00:00–01:00 local time … 167 = Sunday 23:00–24:00; ``closed`` rows (a
+    ``closed_weekdays`` mask) read Sunday's hours."""
     local = times.tz_convert(timezone)
-    return np.asarray(local.day_of_week * 24 + local.hour, dtype=int)
+    day = np.asarray(local.day_of_week)
+    if closed is not None:
+        day = np.where(closed, SUNDAY, day)
+    return np.asarray(day * 24 + local.hour, dtype=int)
 
 
 # Day types of building schedules (EnergyPlus's "Weekdays", "Saturday", "Sunday"): index of each
@@ -43,10 +83,13 @@ DAY_TYPE_OF_WEEKDAY = np.array([0, 0, 0, 0, 0, 1, 2])
 N_DAY_TYPES = 3
 
 
-def day_type_hour(times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
-    """0–23 = weekday hours, 24–47 = Saturday, 48–71 = Sunday, in local time."""
-    local = times.tz_convert(timezone)
-    return np.asarray(DAY_TYPE_OF_WEEKDAY[local.day_of_week] * 24 + local.hour, dtype=int)
+def day_type_hour(
+    times: pd.DatetimeIndex, timezone: Zone, closed: np.ndarray | None = None
+) -> np.ndarray:
+    """0–23 = weekday hours, 24–47 = Saturday, 48–71 = Sunday, in local time (``closed`` rows
+    on Sunday's, ``hour_of_week``)."""
+    how = hour_of_week(times, timezone, closed)
+    return DAY_TYPE_OF_WEEKDAY[how // 24] * 24 + how % 24
 
 
 def weekly_from_day_types(profile: np.ndarray) -> np.ndarray:
@@ -64,12 +107,14 @@ def weekly_profile(values: np.ndarray, times: pd.DatetimeIndex, timezone: Zone) 
     return np.divide(sums, counts, out=np.zeros(HOURS_PER_WEEK), where=counts > 0)
 
 
-def schedule_signal(profile: np.ndarray, times: pd.DatetimeIndex, timezone: Zone) -> np.ndarray:
-    """The weekly profile played back at ``times``."""
+def schedule_signal(
+    profile: np.ndarray, times: pd.DatetimeIndex, timezone: Zone, closed: np.ndarray | None = None
+) -> np.ndarray:
+    """The weekly profile played back at ``times`` (``closed`` rows on Sunday's hours)."""
     profile = np.asarray(profile, dtype=float)
     if profile.shape != (HOURS_PER_WEEK,):
         raise ValueError(f"a weekly schedule has {HOURS_PER_WEEK} values, got {profile.shape}")
-    return profile[hour_of_week(times, timezone)]
+    return profile[hour_of_week(times, timezone, closed)]
 
 
 def on_hours(profile: np.ndarray, fraction: float = 0.5) -> np.ndarray:
