@@ -32,7 +32,7 @@ All assembly is vectorised over a population of parameter sets (leading axis S).
 from __future__ import annotations
 
 import copy
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -230,6 +230,26 @@ class RCNetwork:
         new = copy.deepcopy(self)
         if name is not None:
             new.name = name
+        return new
+
+    def fixed(self, values: dict[str, float], name: str | None = None) -> RCNetwork:
+        """A copy with the parameters ``values`` fixed at those numbers (no longer fitted); a
+        heat input fixed at zero gain is left out, and with it the need for its signal."""
+        unknown = [p for p in values if p not in self.parameters]
+        if unknown:
+            raise ModelError(f"{self.name} has no parameter(s) {unknown}")
+
+        def value(v: Value) -> Value:
+            return float(values[v]) if isinstance(v, str) and v in values else v
+
+        new = self.copy(name)
+        for p in values:
+            del new.parameters[p]
+        new.capacitors = [replace(c, capacity=value(c.capacity)) for c in new.capacitors]
+        new.resistors = [replace(r, resistance=value(r.resistance)) for r in new.resistors]
+        new.heat_inputs = [
+            replace(h, gain=value(h.gain)) for h in new.heat_inputs if value(h.gain) != 0.0
+        ]
         return new
 
     def _check_value(self, value: Value) -> None:

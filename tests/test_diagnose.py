@@ -215,6 +215,9 @@ def test_concealed_effect_is_the_first_finding(name):
     assert case["effect"] not in frame.columns
     d = json.loads(diagnose(frame, building, case["model"]).to_json())
     accepted = [f["effect"] for f in d["findings"] if f["accepted"]]
+    # The final model holds exactly the accepted extensions (one dropped by the backward check
+    # is no longer in it).
+    assert sorted(d["final"]["network"]["name"].split("+")[1:]) == sorted(accepted)
     if case["effect"] is None:
         assert accepted == [], d["verdict"]
         return

@@ -9,8 +9,10 @@ import pandas as pd
 import pytest
 
 from rcengine.dataset import Dataset
+from rcengine.diagnose import selection
 from rcengine.diagnose.fitting import Split, carried_on, split_data, trust_region
 from rcengine.diagnose.folds import (
+    Fold,
     FoldEvidence,
     FoldRule,
     head_to_head,
@@ -18,7 +20,7 @@ from rcengine.diagnose.folds import (
     rolling_folds,
 )
 from rcengine.diagnose.report import Finding
-from rcengine.diagnose.selection import _one_version_each
+from rcengine.diagnose.selection import Selection, _backward, _one_version_each
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
 from rcengine.network import Parameter, RCNetwork
@@ -129,6 +131,93 @@ def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
     first, refined = (_version("unmetered_gains", s, 1.0, 0.8) for s in ("a", "b"))
     first.accepted = False
     assert _one_version_each([first, refined]) == [refined]
+
+
+def _accepted(effect: str, round_no: int, repair: bool = False) -> Finding:
+    return Finding(effect, True, round_no, 0.0, "projection", 1.0, 1.0, baseline_repair=repair)
+
+
+def _backward_check(worth: dict[str, list[float]], monkeypatch) -> Selection:
+    """The backward check on made-up fold errors: ``worth`` gives, per finding in the order they
+    were accepted, the folds' test RMSE without it (with it: 0.5 K in every fold); the reduced
+    fits are tokens."""
+    n = len(next(iter(worth.values())))
+    calls = []
+
+    def without_each(problem, state, judged):
+        calls.append([f.effect for f in judged])
+        reduced = [(f"final without {f.effect}", f"folds without {f.effect}") for f in judged]
+        return reduced, [_evidence(worth[f.effect], [0.5] * n) for f in judged]
+
+    monkeypatch.setattr(selection, "_without_each", without_each)
+    start = pd.Timestamp("2017-01-02", tz="UTC")
+    folds = [Fold(k, start, start + 28 * DAY, start + 42 * DAY) for k in range(n)]
+    problem = SimpleNamespace(
+        folds=folds,
+        settings=SimpleNamespace(fold_rule=FoldRule()),
+        building=SimpleNamespace(location=SimpleNamespace(timezone=TZ)),
+        say=lambda message: None,
+    )
+    accepted = [_accepted(e, k + 1) for k, e in enumerate(worth)]
+    state = Selection(current="final", accepted=[_accepted("thermal_mass", 0, True), *accepted])
+    _backward(problem, state)
+    state.calls = calls
+    return state
+
+
+def test_the_backward_check_drops_a_stand_in_the_later_finding_made_redundant(monkeypatch):
+    # The unmetered gain, taken first, is worth 2 % once the emitter is in: dropped. The repair
+    # step is not judged.
+    state = _backward_check(
+        {"unmetered_gains": [0.52, 0.5, 0.5, 0.49], "emitter_dynamics": [1.0] * 4}, monkeypatch
+    )
+    assert [f.effect for f in state.accepted] == ["thermal_mass", "emitter_dynamics"]
+    dropped = state.verdicts["unmetered_gains"]
+    assert not dropped.accepted and dropped.reason.startswith("dropped by the backward check")
+    assert dropped.backward["still_needed"] is False and dropped.backward["helped"] == 1
+    assert state.current == "final without unmetered_gains"
+    assert state.current_folds == "folds without unmetered_gains"
+    assert state.calls == [["unmetered_gains", "emitter_dynamics"]]  # one left: no second check
+    emitter = state.accepted[1]
+    assert emitter.backward["still_needed"] and emitter.backward["helped"] == 4
+
+
+def test_the_backward_check_orders_the_findings_by_what_leaving_each_out_costs(monkeypatch):
+    state = _backward_check(
+        {
+            "wind_infiltration": [0.7] * 4,
+            "ventilation_schedule": [1.5] * 4,
+            "sky_radiation": [0.9] * 4,
+        },
+        monkeypatch,
+    )
+    assert [f.effect for f in state.accepted] == [
+        "thermal_mass",
+        "ventilation_schedule",
+        "sky_radiation",
+        "wind_infiltration",
+    ]
+    assert state.current == "final" and not state.verdicts
+
+
+def test_the_backward_check_drops_the_least_worth_first_and_checks_again(monkeypatch):
+    # Neither the wind nor the sky helps in most folds in the final model; the sky is worth
+    # less and goes first, then the wind is checked again against the ventilation alone.
+    state = _backward_check(
+        {
+            "ventilation_schedule": [1.5] * 4,
+            "wind_infiltration": [0.52, 0.49, 0.49, 0.52],
+            "sky_radiation": [0.51, 0.49, 0.49, 0.5],
+        },
+        monkeypatch,
+    )
+    assert state.calls == [
+        ["ventilation_schedule", "wind_infiltration", "sky_radiation"],
+        ["ventilation_schedule", "wind_infiltration"],
+    ]
+    assert [f.effect for f in state.accepted] == ["thermal_mass", "ventilation_schedule"]
+    assert set(state.verdicts) == {"wind_infiltration", "sky_radiation"}
+    assert state.current == "final without wind_infiltration"
 
 
 def test_a_fold_refit_stays_near_the_fit_on_the_training_half():

@@ -110,3 +110,19 @@ def test_extension_leaves_original_untouched():
     extended.add_resistor("emitter", "air", 0.01)
     assert base.compile().n_states == 2
     assert extended.compile().n_states == 3
+
+
+def test_fixed_parameters_leave_the_fit_and_a_zero_gain_leaves_its_signal():
+    values = {"r1": 0.02, "r2": 0.01, "c1": 3e5, "c2": 2e6, "g": 7.0}
+    net = two_node()
+    fixed = net.fixed({"c1": 3e5, "g": 0.0}, "2R2C without sun")
+    assert fixed.name == "2R2C without sun"
+    assert set(fixed.parameters) == {"r1", "r2", "c2"}
+    compiled = fixed.compile()
+    assert compiled.input_names == ("t_out", "q_hvac")  # the sun's input had gain 0
+    A, _, _, _ = compiled.state_space({k: values[k] for k in ("r1", "r2", "c2")})
+    A_free, _, _, _ = net.compile().state_space(values)
+    np.testing.assert_allclose(A, A_free, rtol=1e-12)  # c1 fixed at the value it had
+    assert set(net.parameters) == set(values)  # the original is untouched
+    with pytest.raises(ModelError, match="no parameter"):
+        net.fixed({"c_mass": 1.0})

@@ -167,9 +167,16 @@ def _health_box(d: dict) -> str:
     return f"<p>Base model: <span class={cls}>{esc(health['verdict'])}</span></p><ul>{items}</ul>"
 
 
-def _folds_table(finding: dict) -> str:
-    """Per-fold test RMSE before and after a finding's extension, and the pooled test."""
-    folds = finding["folds"]
+def _fold_tables(finding: dict) -> str:
+    """A finding's fold evidence when it was judged, and its backward check's when it had one."""
+    effect = finding["effect"]
+    return _folds_table(f"{effect} across rolling folds", finding["folds"]) + _folds_table(
+        f"{effect} added last, to the other findings (backward check)", finding.get("backward")
+    )
+
+
+def _folds_table(title: str, folds: dict | None) -> str:
+    """Per-fold test RMSE before and after an extension, and the pooled test."""
     if not folds:
         return ""
     rows = "".join(
@@ -184,7 +191,7 @@ def _folds_table(finding: dict) -> str:
         for k, f in enumerate(folds["folds"])
     )
     return (
-        f"<h4>{html.escape(finding['effect'])} across rolling folds: helps in {folds['helped']} "
+        f"<h4>{html.escape(title)}: helps in {folds['helped']} "
         f"of {len(folds['folds'])} (confidence {folds['confidence']:.0%})</h4>"
         "<table><tr><th>test period</th><th>RMSE before [K]</th><th>after [K]</th><th></th></tr>"
         f"{rows}<tr><td><b>pooled</b></td><td>{folds['pooled_rmse_test_before']:.3f}</td>"
@@ -228,7 +235,7 @@ def render(report: Report) -> str:
         f"<h3>{esc(f.effect)}</h3><p>{esc(f.explanation)}</p>{_png(evidence_figure(report, f))}"
         for f in report.accepted
     )
-    folds = "".join(_folds_table(f) for f in d["findings"]) + "".join(
+    folds = "".join(_fold_tables(f) for f in d["findings"]) + "".join(
         f"<p>Fold testing {esc(f['test'])} left out: {esc(f['reason'])}.</p>"
         for f in d["evidence"]["left_out"]
     )

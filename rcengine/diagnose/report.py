@@ -43,7 +43,9 @@ class Finding:
     across the rolling folds (``FoldEvidence.to_dict``), ``evidence`` the residuals behind it;
     runner_up / lost_to: {"effect", "reason"} of the head-to-head between candidates that both
     passed; baseline_repair: taken to make an inadequate base model healthy, not judged as a
-    candidate.
+    candidate; backward: what leaving it out of the final model costs across the folds (the
+    backward check of an accepted finding); neutral: the values of its new parameters at which
+    it does nothing.
     """
 
     effect: str
@@ -67,6 +69,8 @@ class Finding:
     runner_up: dict[str, str] | None = None
     lost_to: dict[str, str] | None = None
     baseline_repair: bool = False
+    backward: dict | None = None
+    neutral: dict[str, float] = field(default_factory=dict)
     screen: Screen | None = None
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
@@ -99,6 +103,7 @@ class Finding:
             "runner_up": self.runner_up,
             "lost_to": self.lost_to,
             "baseline_repair": self.baseline_repair,
+            "backward": self.backward,
         }
 
 
@@ -226,6 +231,7 @@ def _finding(
         screen_method=screened.method,
         rmse_test_before=current.rmse_test,
         rmse_train_before=current.rmse_train,
+        neutral=dict(ext.neutral),
         screen=screened,
         **verdict,
     )

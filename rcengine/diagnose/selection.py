@@ -9,7 +9,9 @@
    magnitudes are plausible for the building; with fold evidence (the default) it must also help
    in most rolling folds across the record and on their pooled test. Of those that pass, a head
    to head on the folds picks the one accepted (the runner-up is reported with why it lost);
-   repeat from the extended model until nothing more is accepted.
+   repeat from the extended model until nothing more is accepted;
+4. check every accepted finding backward: left out of the final model, does it still help across
+   the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
 Before any of this the base model (fitted within bounds derived from the building) is checked for
 health (``health``): against a crippled base model any flexible extension "wins". An inadequate
@@ -39,7 +41,13 @@ from rcengine.diagnose.fitting import (
     split_data,
     trust_region,
 )
-from rcengine.diagnose.folds import Fold, FoldEvidence, head_to_head, rolling_folds
+from rcengine.diagnose.folds import (
+    Fold,
+    FoldEvidence,
+    head_to_head,
+    judge_folds,
+    rolling_folds,
+)
 from rcengine.diagnose.health import FitQuality, Health, check_health, fit_quality
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.plausibility import assess
@@ -158,6 +166,7 @@ def _diagnose(
         problem.say(f"  {health.summary()}")
         _repair(problem, state)
     _select(problem, state)
+    _backward(problem, state)
     findings = state.findings(locate["train"]["summary"])
     whiteness = {
         "baseline": ljung_box(baseline.innovations_test, baseline.split.test.times),
@@ -498,11 +507,34 @@ def _confirm_on_folds(
     passing = [(e, f) for e, f in zip(extensions, findings, strict=True) if f.accepted]
     if not passing:
         return
-    settings, n = problem.settings, len(problem.folds)
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
     if state.current_folds is None:
         models.insert(0, (state.current.network, state.current.options, state.current.params))
-    problem.say(f"  confirming {', '.join(e.effect for e, _ in passing)} on {n} rolling folds")
+    problem.say(
+        f"  confirming {', '.join(e.effect for e, _ in passing)} on {len(problem.folds)} "
+        "rolling folds"
+    )
+    fits = _fold_fits(problem, models)
+    if state.current_folds is None:
+        state.current_folds, *fits = fits
+    before = tuple(f.residual_test for f in state.current_folds)
+    for (_, finding), fold_fits in zip(passing, fits, strict=True):
+        after = tuple(f.residual_test for f in fold_fits)
+        confirm_on_folds(
+            finding,
+            FoldEvidence(before, after),
+            problem.folds,
+            problem.settings,
+            problem.building.location.timezone,
+        )
+
+
+def _fold_fits(
+    problem: Problem, models: list[tuple[RCNetwork, SignalOptions, dict[str, float]]]
+) -> list[list[Fit]]:
+    """Each model (network, signals, its fit on the training period) refitted on every fold,
+    warm-started from that fit and within its ``trust_region``, in one parallel batch."""
+    settings, n = problem.settings, len(problem.folds)
     jobs = [
         FitJob(
             network,
@@ -517,18 +549,84 @@ def _confirm_on_folds(
         for split in fold_splits(problem.frame, problem.building, network, options, problem.folds)
     ]
     fits = fit_many(jobs, settings.workers)
-    if state.current_folds is None:
-        state.current_folds, fits = fits[:n], fits[n:]
-    before = tuple(f.residual_test for f in state.current_folds)
-    for k, (_, finding) in enumerate(passing):
-        after = tuple(f.residual_test for f in fits[k * n : (k + 1) * n])
-        confirm_on_folds(
-            finding,
-            FoldEvidence(before, after),
-            problem.folds,
-            settings,
-            problem.building.location.timezone,
+    return [fits[k * n : (k + 1) * n] for k in range(len(models))]
+
+
+def _backward(problem: Problem, state: Selection) -> None:
+    """The backward step of a stepwise selection (Efroymson 1960): every accepted finding is
+    left out of the final model again, the rest refitted from the final model's parameters, and
+    judged on the folds by what it is still worth there.
+
+    A forward selection can take a flexible candidate first (a learnt gain schedule) that stands
+    in for part of an effect it cannot express; once the effect itself is in, the stand-in may
+    explain nothing more. And a finding is credited with whatever its refit gained, including
+    a better optimum of the parameters it did not add: the last finding too is checked, since the
+    model without it, refitted from the final parameters, need not be the one it was judged
+    against. The finding that no longer helps across the folds (``FoldRule``, the rule it
+    entered by) and is worth least is dropped and the check repeated on the model without it;
+    the findings kept are ordered by what leaving each out costs on the folds' pooled test, the
+    one that matters most first. Steps taken to make the base model healthy are not candidates
+    and stay first.
+    """
+    rule, timezone = problem.settings.fold_rule, problem.building.location.timezone
+    while problem.folds:
+        judged = [f for f in state.accepted if not f.baseline_repair]
+        if len(judged) < 2:
+            return
+        problem.say(f"  checking {', '.join(f.effect for f in judged)} backward")
+        reduced, evidence = _without_each(problem, state, judged)
+        worth: dict[str, float] = {}
+        failing = []
+        for finding, ev in zip(judged, evidence, strict=True):
+            ok, text = judge_folds(ev, rule)
+            worth[finding.effect] = ev.pooled_before - ev.pooled_after
+            finding.backward = {**ev.to_dict(problem.folds, timezone), "still_needed": ok}
+            finding.backward["reason"] = f"added last, to the other findings: {text}"
+            if not ok:
+                failing.append(finding)
+        state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
+        if not failing:
+            return
+        dropped = min(failing, key=lambda f: worth[f.effect])
+        dropped.accepted = False
+        dropped.reason = f"dropped by the backward check: {dropped.backward['reason']}"
+        state.accepted.remove(dropped)
+        state.verdicts[dropped.effect] = dropped
+        state.current, state.current_folds = reduced[judged.index(dropped)]
+
+
+def _without_each(
+    problem: Problem, state: Selection, judged: list[Finding]
+) -> tuple[list[tuple[Fit, list[Fit]]], list[FoldEvidence]]:
+    """The final model without each finding in ``judged`` (its new parameters fixed where it does
+    nothing): fitted on the training period and on every fold; and per finding the folds' test
+    errors without it (``before``) and with it (``after``, the final model's)."""
+    settings, final = problem.settings, state.current
+    networks = [
+        final.network.fixed(f.neutral, final.network.name.replace(f"+{f.effect}", ""))
+        for f in judged
+    ]
+    jobs = [
+        FitJob(
+            network,
+            final.options,
+            problem.split(network, final.options),
+            settings.preset,
+            settings.random_state,
+            [dict(final.params)],
         )
+        for network in networks
+    ]
+    fits = fit_many(jobs, settings.workers)
+    models = [(f.network, f.options, f.params) for f in fits]
+    if state.current_folds is None:
+        models.insert(0, (final.network, final.options, final.params))
+    fold_fits = _fold_fits(problem, models)
+    if state.current_folds is None:
+        state.current_folds, *fold_fits = fold_fits
+    after = tuple(f.residual_test for f in state.current_folds)
+    evidence = [FoldEvidence(tuple(f.residual_test for f in ff), after) for ff in fold_fits]
+    return list(zip(fits, fold_fits, strict=True)), evidence
 
 
 def _winner(
