@@ -195,6 +195,19 @@ def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
     assert [p for p in hot.problems if p.startswith("mean ground temperature")], hot.problems
 
 
+def test_the_soil_under_a_floor_may_be_as_cold_as_the_undisturbed_soil_in_winter(gain_context):
+    """In winter the undisturbed soil at the slab's depth is below the annual mean (here by 6 K):
+    a ground temperature between the two is plausible, one colder than both is not."""
+    ground = CANDIDATES["ground_coupling"](gain_context)
+    annual = ground.detail["outdoor_mean_c"]
+    winter = replace(ground, detail={**ground.detail, "ground_base_c": annual - 6.0})
+    cold = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - 7.5)})
+    assert not [p for p in cold.problems if p.startswith("mean ground temperature")], cold.problems
+    colder = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - 8.5)})
+    (problem,) = [p for p in colder.problems if p.startswith("mean ground temperature")]
+    assert f"(≥ {annual - 8.0:.3g} °C)" in problem
+
+
 def test_window_sun_beyond_the_declared_glazing_is_bounded_by_the_facade(gain_context):
     """The west facade holds 6 m² of glazing in 36 m²: its sun may reach that of clear glass
     over the whole facade, 0.87 × 36 / 6 = 5.2 times its declared glazing's."""

@@ -63,8 +63,11 @@ UNMETERED_W_M2: Range = (0.0, 40.0)
 # Ground floor U-value: a slab under 300 mm of insulation to an uninsulated slab of a small
 # building (ISO 13370, the base models' ``U_GROUND_MAX``). [W/(m²K)]
 U_FLOOR: Range = (0.05, U_GROUND_MAX)
-# The soil under a floor lies between the outdoor annual mean and the indoor temperature (heat
-# flows from the one to the other, ISO 13370); the margin covers their estimates. [K]
+# The soil under a floor lies between the undisturbed soil and the indoor temperature (heat flows
+# from the one to the other, ISO 13370): the building warms it in winter and shades it in summer,
+# so over a period it is no colder than both the undisturbed soil at the slab's depth then (the
+# damped, lagged annual wave, below the annual mean in winter) and the annual mean. The margin
+# covers their estimates. [K]
 GROUND_TEMPERATURE_MARGIN_K = 2.0
 # Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
 # −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
@@ -267,12 +270,12 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Floor U-value 1/r_floor and the fitted mean ground temperature: the damped outdoor annual
-    mean raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base))."""
+    """Floor U-value 1/r_floor and the fitted mean ground temperature: the undisturbed soil's
+    T_base raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base))."""
     d = ext.detail
     r = params["r_floor"]
     t_ground = d["ground_base_c"] + params["q_ground"] * r
-    low = d["outdoor_mean_c"] - GROUND_TEMPERATURE_MARGIN_K
+    low = min(d["ground_base_c"], d["outdoor_mean_c"]) - GROUND_TEMPERATURE_MARGIN_K
     high = d["indoor_mean_c"] + GROUND_TEMPERATURE_MARGIN_K
     return [
         Reading("u_floor", 1.0 / r, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),
@@ -282,7 +285,7 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             "°C",
             "mean ground temperature under the floor over the training period",
             (low, high),
-            "soil between the outdoor annual mean and the indoor air",
+            "soil between the undisturbed soil and the indoor air",
         ),
     ]
 
