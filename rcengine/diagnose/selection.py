@@ -508,15 +508,11 @@ def _confirm_on_folds(
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
-    if state.current_folds is None:
-        models.insert(0, (state.current.network, state.current.options, state.current.params))
     problem.say(
         f"  confirming {', '.join(e.effect for e, _ in passing)} on {len(problem.folds)} "
         "rolling folds"
     )
-    fits = _fold_fits(problem, models)
-    if state.current_folds is None:
-        state.current_folds, *fits = fits
+    fits = _fold_fits_beside_current(problem, state, models)
     before = tuple(f.residual_test for f in state.current_folds)
     for (_, finding), fold_fits in zip(passing, fits, strict=True):
         after = tuple(f.residual_test for f in fold_fits)
@@ -527,6 +523,22 @@ def _confirm_on_folds(
             problem.settings,
             problem.building.location.timezone,
         )
+
+
+def _fold_fits_beside_current(
+    problem: Problem,
+    state: Selection,
+    models: list[tuple[RCNetwork, SignalOptions, dict[str, float]]],
+) -> list[list[Fit]]:
+    """``_fold_fits`` of the models; the current model's too, in the same batch, when it has
+    none yet (kept in ``state.current_folds``)."""
+    current = state.current
+    if state.current_folds is not None:
+        return _fold_fits(problem, models)
+    state.current_folds, *fits = _fold_fits(
+        problem, [(current.network, current.options, current.params), *models]
+    )
+    return fits
 
 
 def _fold_fits(
@@ -619,11 +631,7 @@ def _without_each(
     ]
     fits = fit_many(jobs, settings.workers)
     models = [(f.network, f.options, f.params) for f in fits]
-    if state.current_folds is None:
-        models.insert(0, (final.network, final.options, final.params))
-    fold_fits = _fold_fits(problem, models)
-    if state.current_folds is None:
-        state.current_folds, *fold_fits = fold_fits
+    fold_fits = _fold_fits_beside_current(problem, state, models)
     after = tuple(f.residual_test for f in state.current_folds)
     evidence = [FoldEvidence(tuple(f.residual_test for f in ff), after) for ff in fold_fits]
     return list(zip(fits, fold_fits, strict=True)), evidence
