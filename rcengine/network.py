@@ -233,8 +233,9 @@ class RCNetwork:
         return new
 
     def fixed(self, values: dict[str, float], name: str | None = None) -> RCNetwork:
-        """A copy with the parameters ``values`` fixed at those numbers (no longer fitted); a
-        heat input fixed at zero gain is left out, and with it the need for its signal."""
+        """A copy with the parameters ``values`` fixed at those numbers (no longer fitted). A heat
+        input fixed at zero gain and a resistor fixed at infinite resistance (an open circuit)
+        are left out, and with them a signal nothing uses any more."""
         unknown = [p for p in values if p not in self.parameters]
         if unknown:
             raise ModelError(f"{self.name} has no parameter(s) {unknown}")
@@ -246,10 +247,19 @@ class RCNetwork:
         for p in values:
             del new.parameters[p]
         new.capacitors = [replace(c, capacity=value(c.capacity)) for c in new.capacitors]
-        new.resistors = [replace(r, resistance=value(r.resistance)) for r in new.resistors]
+        new.resistors = [
+            replace(r, resistance=value(r.resistance))
+            for r in new.resistors
+            if value(r.resistance) != np.inf
+        ]
         new.heat_inputs = [
             replace(h, gain=value(h.gain)) for h in new.heat_inputs if value(h.gain) != 0.0
         ]
+        ends = {end for r in new.resistors for end in (r.a, r.b)}
+        new.temperatures = [t for t in new.temperatures if t in ends]
+        elements = [c.capacity for c in new.capacitors] + [r.resistance for r in new.resistors]
+        for v in elements + [h.gain for h in new.heat_inputs]:
+            new._check_value(v)
         return new
 
     def _check_value(self, value: Value) -> None:

@@ -126,3 +126,20 @@ def test_fixed_parameters_leave_the_fit_and_a_zero_gain_leaves_its_signal():
     assert set(net.parameters) == set(values)  # the original is untouched
     with pytest.raises(ModelError, match="no parameter"):
         net.fixed({"c_mass": 1.0})
+
+
+def test_a_resistor_fixed_at_infinity_is_an_open_circuit_and_its_boundary_leaves():
+    """A floor to the ground fixed open (r = ∞) is the network without that path: same
+    matrices, and the ground temperature is no longer an input."""
+    net = two_node()
+    net.add_parameter(Parameter("r_floor", "m²K/W", 0.1, 20.0))
+    net.add_resistor("t_ground", "wall", "r_floor")
+    opened = net.fixed({"r_floor": np.inf})
+    assert "t_ground" not in opened.compile().input_names
+    values = {"r1": 0.02, "r2": 0.01, "c1": 3e5, "c2": 2e6, "g": 7.0}
+    A, B, _, _ = opened.compile().state_space(values)
+    A_none, B_none, _, _ = two_node().compile().state_space(values)
+    np.testing.assert_allclose(A, A_none, rtol=1e-12)
+    np.testing.assert_allclose(B, B_none, rtol=1e-12)
+    with pytest.raises(ModelError, match="finite"):
+        net.fixed({"c1": np.inf})

@@ -372,3 +372,14 @@ def test_a_heater_at_capacity_is_not_learnt_as_a_gain_schedule(monkeypatch):
     monkeypatch.setattr(candidates, "heater_saturated", lambda f: np.zeros(len(f), dtype=bool))
     unmasked = CANDIDATES["unmetered_gains"](ctx)
     assert set(on_hours(unmasked)) & set(at_capacity)
+
+
+def test_the_ground_candidate_left_out_is_exactly_the_model_it_extended(gain_context):
+    """The backward check's model without the ground: the floor's path open (r_floor = ∞), the
+    soil's heat zero; the same matrices and inputs as the model before it was added."""
+    ground = CANDIDATES["ground_coupling"](gain_context)
+    without = ground.network.fixed(ground.absent).compile()
+    base = gain_context.network.compile()
+    assert without.input_names == base.input_names
+    for a, b in zip(without.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12)

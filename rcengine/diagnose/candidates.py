@@ -105,6 +105,9 @@ class Extension:
     # Values of the new parameters at which the extension does nothing: the refit's warm start
     # then contains the current model itself, so it can only improve on it.
     neutral: dict[str, float] = field(default_factory=dict)
+    # Values at which it is absent altogether (the backward check's model without it), where
+    # they lie outside its search box: a conduction path open, r = ∞. Default ``neutral``.
+    absent: dict[str, float] | None = None
     # Facts an explanation quotes and ``plausibility.assess`` reads (areas, volume, temperatures).
     detail: dict = field(default_factory=dict)
 
@@ -611,6 +614,7 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
         ("r_floor", "q_ground"),
         ((T_GROUND, target), (UNIT, target)),
         neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
+        absent={"r_floor": np.inf, "q_ground": 0.0},
         detail={"node": target, "floor_area_m2": floor, **_ground_temperatures(ctx)},
     )
 

@@ -44,8 +44,8 @@ class Finding:
     runner_up / lost_to: {"effect", "reason"} of the head-to-head between candidates that both
     passed; baseline_repair: taken to make an inadequate base model healthy, not judged as a
     candidate; backward: what leaving it out of the final model costs across the folds (the
-    backward check of an accepted finding); neutral: the values of its new parameters at which
-    it does nothing.
+    backward check of an accepted finding); absent: the values of its new parameters at which it
+    is left out (``Extension.absent``).
     """
 
     effect: str
@@ -70,7 +70,7 @@ class Finding:
     lost_to: dict[str, str] | None = None
     baseline_repair: bool = False
     backward: dict | None = None
-    neutral: dict[str, float] = field(default_factory=dict)
+    absent: dict[str, float] = field(default_factory=dict)
     screen: Screen | None = None
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
@@ -231,7 +231,7 @@ def _finding(
         screen_method=screened.method,
         rmse_test_before=current.rmse_test,
         rmse_train_before=current.rmse_train,
-        neutral=dict(ext.neutral),
+        absent=dict(ext.neutral if ext.absent is None else ext.absent),
         screen=screened,
         **verdict,
     )

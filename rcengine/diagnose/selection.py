@@ -615,7 +615,7 @@ def _without_each(
     errors without it (``before``) and with it (``after``, the final model's)."""
     settings, final = problem.settings, state.current
     networks = [
-        final.network.fixed(f.neutral, final.network.name.replace(f"+{f.effect}", ""))
+        final.network.fixed(f.absent, final.network.name.replace(f"+{f.effect}", ""))
         for f in judged
     ]
     jobs = [
