@@ -233,9 +233,15 @@ class RCNetwork:
         return new
 
     def fixed(self, values: dict[str, float], name: str | None = None) -> RCNetwork:
-        """A copy with the parameters ``values`` fixed at those numbers (no longer fitted). A heat
-        input fixed at zero gain and a resistor fixed at infinite resistance (an open circuit)
-        are left out, and with them a signal nothing uses any more."""
+        """A copy with the parameters ``values`` fixed at those numbers (no longer fitted).
+
+        Elements at the ends of their range are left out exactly, as the limits of the network's
+        equations: a heat input of zero gain and a resistor of infinite resistance (an open
+        circuit) are removed; a capacity of zero makes its node massless; a resistor of zero
+        resistance (a short circuit) joins a massless node to its neighbour, which takes its
+        resistors and heat inputs. A node nothing connects any more leaves, with the heat into
+        it (none of which could reach another node), and so does a boundary temperature, a signal
+        or a parameter nothing uses any more."""
         unknown = [p for p in values if p not in self.parameters]
         if unknown:
             raise ModelError(f"{self.name} has no parameter(s) {unknown}")
@@ -244,9 +250,12 @@ class RCNetwork:
             return float(values[v]) if isinstance(v, str) and v in values else v
 
         new = self.copy(name)
+        used = self._used_parameters()
         for p in values:
             del new.parameters[p]
-        new.capacitors = [replace(c, capacity=value(c.capacity)) for c in new.capacitors]
+        capacitors = [replace(c, capacity=value(c.capacity)) for c in new.capacitors]
+        new.capacitors = [c for c in capacitors if c.capacity != 0.0]
+        new.massless += [c.node for c in capacitors if c.capacity == 0.0]
         new.resistors = [
             replace(r, resistance=value(r.resistance))
             for r in new.resistors
@@ -255,12 +264,58 @@ class RCNetwork:
         new.heat_inputs = [
             replace(h, gain=value(h.gain)) for h in new.heat_inputs if value(h.gain) != 0.0
         ]
-        ends = {end for r in new.resistors for end in (r.a, r.b)}
-        new.temperatures = [t for t in new.temperatures if t in ends]
+        while shorts := [r for r in new.resistors if r.resistance == 0.0]:
+            new._short_circuit(shorts[0])
+        new._drop_unconnected()
+        for p in used - new._used_parameters():
+            new.parameters.pop(p, None)
         elements = [c.capacity for c in new.capacitors] + [r.resistance for r in new.resistors]
         for v in elements + [h.gain for h in new.heat_inputs]:
             new._check_value(v)
         return new
+
+    def _used_parameters(self) -> set[str]:
+        values = [c.capacity for c in self.capacitors] + [r.resistance for r in self.resistors]
+        return {v for v in values + [h.gain for h in self.heat_inputs] if isinstance(v, str)}
+
+    def _short_circuit(self, short: Resistor) -> None:
+        """Join the ends of a zero resistance: a massless end is absorbed by the other."""
+        ends = (short.a, short.b)
+        if any(end in self.temperatures for end in ends):
+            raise ModelError(
+                f"{self.name}: a zero resistance between {short.a!r} and {short.b!r} would hold a "
+                "node at a prescribed temperature"
+            )
+        gone = next((e for e in ends if e in self.massless and e != self.output), None)
+        if gone is None:
+            gone = next((e for e in ends if e in self.massless), None)
+        if gone is None:
+            raise ModelError(
+                f"{self.name}: a zero resistance may only join a massless node to another, not "
+                f"{short.a!r} and {short.b!r}, which both have heat capacity"
+            )
+        kept = short.b if gone == short.a else short.a
+        self.resistors.remove(short)
+        self.massless.remove(gone)
+        rejoined = [
+            replace(r, a=kept if r.a == gone else r.a, b=kept if r.b == gone else r.b)
+            for r in self.resistors
+        ]
+        self.resistors = [r for r in rejoined if r.a != r.b]
+        self.heat_inputs = [
+            replace(h, node=kept) if h.node == gone else h for h in self.heat_inputs
+        ]
+        if self.output == gone:
+            self.output = kept
+
+    def _drop_unconnected(self) -> None:
+        """Remove nodes without a resistor (the output aside) and boundaries nothing touches."""
+        ends = {end for r in self.resistors for end in (r.a, r.b)}
+        alone = {n for n in self.nodes if n not in ends and n != self.output}
+        self.capacitors = [c for c in self.capacitors if c.node not in alone]
+        self.massless = [n for n in self.massless if n not in alone]
+        self.heat_inputs = [h for h in self.heat_inputs if h.node not in alone]
+        self.temperatures = [t for t in self.temperatures if t in ends]
 
     def _check_value(self, value: Value) -> None:
         if isinstance(value, str):

@@ -128,6 +128,66 @@ def test_fixed_parameters_leave_the_fit_and_a_zero_gain_leaves_its_signal():
         net.fixed({"c_mass": 1.0})
 
 
+def with_emitter() -> RCNetwork:
+    """``two_node`` with q_hvac reaching the air through an emitter of capacity ce behind re."""
+    net = two_node()
+    net.add_parameter(Parameter("ce", "J/K", 0.0, 1e6))
+    net.add_parameter(Parameter("re", "K/W", 0.0, 1.0))
+    net.add_capacitor("emitter", "ce")
+    net.add_resistor("emitter", "air", "re")
+    net.move_heat_input("q_hvac", "air", "emitter")
+    return net
+
+
+def test_a_capacity_fixed_at_zero_is_a_massless_node_and_a_zero_resistance_joins_it():
+    """C = 0 is the massless node of the same network (Kron-reduced); joined to the air by
+    r = 0 as well, the emitter is gone and q_hvac enters the air: the network without it."""
+    values = {"r1": 0.02, "r2": 0.01, "c1": 3e5, "c2": 2e6, "g": 7.0}
+    massless = with_emitter().fixed({"ce": 0.0})
+    assert massless.states == ["wall", "air"] and massless.massless == ["emitter"]
+    by_hand = two_node()
+    by_hand.add_parameter(Parameter("re", "K/W", 0.0, 1.0))
+    by_hand.add_node("emitter")
+    by_hand.add_resistor("emitter", "air", "re")
+    by_hand.move_heat_input("q_hvac", "air", "emitter")
+    for a, b in zip(
+        massless.compile().state_space({**values, "re": 0.05}),
+        by_hand.compile().state_space({**values, "re": 0.05}),
+        strict=True,
+    ):
+        np.testing.assert_allclose(a, b, rtol=1e-12)
+    joined = with_emitter().fixed({"ce": 0.0, "re": 0.0})
+    assert joined.nodes == ["wall", "air"]
+    for a, b in zip(
+        joined.compile().state_space(values), two_node().compile().state_space(values), strict=True
+    ):
+        np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_a_zero_resistance_between_two_capacities_or_to_a_boundary_is_refused():
+    with pytest.raises(ModelError, match="both have heat capacity"):
+        with_emitter().fixed({"re": 0.0})
+    with pytest.raises(ModelError, match="prescribed temperature"):
+        two_node().fixed({"r1": 0.0, "c1": 0.0})
+
+
+def test_a_node_cut_off_by_an_open_circuit_leaves_with_the_heat_into_it():
+    values = {"r1": 0.02, "r2": 0.01, "c1": 3e5, "c2": 2e6, "g": 7.0}
+    net = two_node()
+    net.add_parameter(Parameter("cm", "J/K", 0.0, 1e7))
+    net.add_parameter(Parameter("rm", "K/W", 1e-3, 1.0))
+    net.add_capacitor("mass", "cm")
+    net.add_resistor("mass", "air", "rm")
+    net.add_heat_input("q_sun_mass", "mass")
+    cut = net.fixed({"rm": np.inf})
+    assert cut.states == ["wall", "air"] and set(cut.parameters) == set(values)
+    assert cut.compile().input_names == two_node().compile().input_names
+    A, B, _, _ = cut.compile().state_space(values)
+    A_none, B_none, _, _ = two_node().compile().state_space(values)
+    np.testing.assert_allclose(A, A_none, rtol=1e-12)
+    np.testing.assert_allclose(B, B_none, rtol=1e-12)
+
+
 def test_a_resistor_fixed_at_infinity_is_an_open_circuit_and_its_boundary_leaves():
     """A floor to the ground fixed open (r = ∞) is the network without that path: same
     matrices, and the ground temperature is no longer an input."""

@@ -374,12 +374,16 @@ def test_a_heater_at_capacity_is_not_learnt_as_a_gain_schedule(monkeypatch):
     assert set(on_hours(unmasked)) & set(at_capacity)
 
 
-def test_the_ground_candidate_left_out_is_exactly_the_model_it_extended(gain_context):
-    """The backward check's model without the ground: the floor's path open (r_floor = ∞), the
-    soil's heat zero; the same matrices and inputs as the model before it was added."""
-    ground = CANDIDATES["ground_coupling"](gain_context)
-    without = ground.network.fixed(ground.absent).compile()
-    base = gain_context.network.compile()
-    assert without.input_names == base.input_names
-    for a, b in zip(without.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True):
+@pytest.mark.parametrize("effect", ["ground_coupling", "thermal_mass", "emitter_dynamics"])
+def test_a_candidate_left_out_is_exactly_the_model_it_extended(gain_context, effect):
+    """The backward check's model without a finding: the floor's path to the ground open
+    (r_floor = ∞); the added storage without capacity or coupling, so its node leaves; the
+    emitter without capacity and joined to the air (r = 0), so q_hvac enters the air again. The
+    same states, matrices and inputs as the model before it was added."""
+    candidate = CANDIDATES[effect](gain_context)
+    without = candidate.network.fixed(candidate.absent)
+    assert without.states == gain_context.network.states
+    compiled, base = without.compile(), gain_context.network.compile()
+    assert compiled.input_names == base.input_names
+    for a, b in zip(compiled.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-12)

@@ -106,7 +106,9 @@ class Extension:
     # then contains the current model itself, so it can only improve on it.
     neutral: dict[str, float] = field(default_factory=dict)
     # Values at which it is absent altogether (the backward check's model without it), where
-    # they lie outside its search box: a conduction path open, r = ∞. Default ``neutral``.
+    # they lie outside its search box: a conduction path open (r = ∞), a node without capacity
+    # joined to its neighbour (C = 0, r = 0); ``RCNetwork.fixed`` removes them. Default
+    # ``neutral``.
     absent: dict[str, float] | None = None
     # Facts an explanation quotes and ``plausibility.assess`` reads (areas, volume, temperatures).
     detail: dict = field(default_factory=dict)
@@ -706,6 +708,7 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
         ("c_mass_extra", "r_mass_extra"),
         structural=True,
         neutral={"c_mass_extra": 1e3, "r_mass_extra": 5.0},
+        absent={"c_mass_extra": 0.0, "r_mass_extra": np.inf},
         detail={
             "node": node,
             "floor_area_m2": floor,
@@ -755,6 +758,7 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
         ("c_emitter", "r_emitter"),
         structural=True,
         neutral={"c_emitter": 1e2, "r_emitter": 1e-3},
+        absent={"c_emitter": 0.0, "r_emitter": 0.0},
         detail={"node": "emitter", "floor_area_m2": floor},
     )
 
