@@ -4,9 +4,12 @@ hand-computed Fresnel optics, and the per-facade heat signals."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
+from pvlib import clearsky
 from pvlib.iotools import read_epw
 
 from rcengine.building import Building, Location, Surface
@@ -21,6 +24,7 @@ from rcengine.signals.solar import (
     glazing_diffuse_iam,
     glazing_iam,
     interval_midpoints,
+    linke_turbidity,
     orientation_key,
     solar_gains,
     solar_position,
@@ -454,3 +458,17 @@ def test_clear_sky_ghi_and_index():
     assert index[12] == 0.0 and index[0] == 0.0
     assert index[11] == 1.5
     np.testing.assert_allclose(index[(clear > 10) & np.isfinite(ghi) & (index < 1.5)], 0.5)
+
+
+def test_linke_turbidity_is_pvlibs_daily_interpolation_without_its_deprecated_accessor():
+    """Across a leap year and both turns of the year, the same values as pvlib's interpolated
+    lookup (which reads pandas' deprecated ``dayofyear``), and no warning of our own."""
+    times = pd.date_range("2015-12-20", "2017-01-10", freq="37min", tz="Europe/Rome")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        expected = clearsky.lookup_linke_turbidity(times, 45.22, 7.65).to_numpy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = linke_turbidity(times, 45.22, 7.65)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+    assert 2.0 < got.min() < got.max() < 6.0

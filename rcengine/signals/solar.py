@@ -15,6 +15,7 @@ the lower-level functions take the instants at which to evaluate the sun as give
 
 from __future__ import annotations
 
+import calendar
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -81,8 +82,8 @@ def day_of_year(times: pd.DatetimeIndex) -> np.ndarray:
 
 @contextmanager
 def _pvlib_reads_dayofyear() -> Iterator[None]:
-    # pvlib 0.16.1's dirint and lookup_linke_turbidity read the deprecated DatetimeIndex.dayofyear
-    # themselves and take no day numbers instead; only that warning is silenced, only here.
+    # pvlib 0.16.1's dirint reads the deprecated DatetimeIndex.dayofyear itself and takes no day
+    # numbers instead; only that warning is silenced, only here.
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message=r"DatetimeIndex\.dayofyear is deprecated")
         yield
@@ -419,6 +420,36 @@ def solar_gains(
     return pd.DataFrame({**totals, **per_window, **per_wall}, index=frame.index)
 
 
+def linke_turbidity(times: pd.DatetimeIndex, latitude: float, longitude: float) -> np.ndarray:
+    """Linke turbidity at each instant [-]: pvlib's monthly climatology of the site
+    (``LinkeTurbidities.h5``, Remund et al. 2003), each month's value placed at its middle day
+    and interpolated linearly over the UTC day of the year, December and January repeated
+    across the turn of the year — pvlib's own interpolation (``interp_turbidity=True``), done
+    here on day numbers: pvlib's reads the deprecated ``DatetimeIndex.dayofyear``.
+    """
+    months = pd.date_range("2001-01-01", periods=12, freq="MS", tz="UTC") + pd.Timedelta(days=14)
+    monthly = clearsky.lookup_linke_turbidity(
+        months, latitude, longitude, interp_turbidity=False
+    ).to_numpy()
+    values = np.concatenate([monthly[-1:], monthly, monthly[:1]])
+    utc = times.tz_convert("UTC")
+    day = day_of_year(times)
+    out = np.empty(len(times))
+    for leap in (False, True):
+        rows = np.asarray(utc.is_leap_year) == leap
+        out[rows] = np.interp(day[rows], _month_middles(leap), values)
+    return out
+
+
+def _month_middles(leap: bool) -> np.ndarray:
+    """Day of the year of the middle of each month, with last December's and next January's
+    either side. [day]"""
+    lengths = np.array(calendar.mdays[1:], dtype=float)
+    lengths[1] += leap
+    middles = np.cumsum(lengths) - lengths / 2.0
+    return np.concatenate([[-15.5], middles, [lengths.sum() + 15.5]])
+
+
 def clear_sky_ghi(times: pd.DatetimeIndex, location: Location) -> np.ndarray:
     """Clear-sky global horizontal irradiance of the intervals starting at ``times``. [W/m²]
 
@@ -431,10 +462,7 @@ def clear_sky_ghi(times: pd.DatetimeIndex, location: Location) -> np.ndarray:
         atmosphere.get_relative_airmass(position["apparent_zenith"].to_numpy()),
         atmosphere.alt2pres(location.altitude),
     )
-    with _pvlib_reads_dayofyear():
-        turbidity = clearsky.lookup_linke_turbidity(
-            midpoints, location.latitude, location.longitude
-        ).to_numpy()
+    turbidity = linke_turbidity(midpoints, location.latitude, location.longitude)
     # The night rows (air mass NaN) divide by zero inside pvlib; they are set to 0 below.
     with np.errstate(divide="ignore", invalid="ignore"):
         clear = clearsky.ineichen(
