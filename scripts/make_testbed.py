@@ -4,10 +4,12 @@
     python scripts/make_testbed.py --jobs 2                 # two cases at a time
     python scripts/make_testbed.py --only light-torino-null # some cases (manifest updated)
     python scripts/make_testbed.py --out /tmp/testbed       # elsewhere
+    python scripts/make_testbed.py --set testbed_fresh      # the fresh held-out set
 
 Writes ``<case>/data.csv`` and ``<case>/building.json`` per case, ``manifest.json`` (archetype,
 climate, rotation, concealed effects with their physical magnitudes and measured strengths) and
-``split.json`` (the seeded tuning / held-out draw). See ``scripts/energyplus/testbed.py``.
+``split.json`` (the seeded tuning / held-out draw; the fresh set, ``data/testbed_fresh/``, is held
+out whole). See ``scripts/energyplus/testbed.py``.
 """
 
 from __future__ import annotations
@@ -20,21 +22,25 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `scripts.energyplus` importable
 
-from scripts.energyplus.run import add_out_option  # noqa: E402
-from scripts.energyplus.testbed import CASES, make_testbed  # noqa: E402
+from scripts.energyplus.testbed import SETS, make_testbed  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--set", choices=SETS, default="testbed", help="which cases (data/SET)")
     parser.add_argument(
-        "--only", nargs="+", choices=[c.name for c in CASES], help="regenerate only these cases"
+        "--only",
+        nargs="+",
+        choices=sorted(c.name for cases in SETS.values() for c in cases),
+        help="regenerate only these cases",
     )
     parser.add_argument("--jobs", type=int, default=1, help="cases simulated at a time")
-    add_out_option(parser, "testbed")
+    parser.add_argument("--out", type=Path, help="output directory (default: data/SET)")
     args = parser.parse_args(argv)
+    out = args.out or ROOT / "data" / args.set
     started = time.perf_counter()
-    make_testbed(args.out, args.only, args.jobs)
-    print(f"done in {time.perf_counter() - started:.1f} s -> {args.out}")
+    make_testbed(out, args.only, args.jobs, cases=SETS[args.set])
+    print(f"done in {time.perf_counter() - started:.1f} s -> {out}")
 
 
 if __name__ == "__main__":

@@ -128,6 +128,11 @@ CLIMATES = {
             "USA_VA_Sterling-Washington.Dulles.Intl.AP.724030_TMY3.epw",
             Calendar("America/New_York", *US_DST, (12, 22), 12),
         ),
+        Climate(
+            "sanfrancisco",
+            "USA_CA_San.Francisco.Intl.AP.724940_TMY3.epw",
+            Calendar("America/Los_Angeles", *US_DST, (12, 22), 12),
+        ),
     )
 }
 
@@ -351,6 +356,38 @@ def _cases() -> tuple[Case, ...]:
 
 
 CASES = _cases()
+
+
+def _fresh_cases() -> tuple[Case, ...]:
+    """A second held-out set, written down before any of it was simulated or diagnosed, after
+    the first held-out half had been read and run many times: every effect once at a magnitude
+    between the main bed's weak and strong, on archetype × climate × orientation combinations
+    the main bed does not have, San Francisco's mild, windy winter among them; three null
+    cases and two with two effects. It is diagnosed, never tuned on."""
+    open_w = _windows("open_plan", "sanfrancisco", 300.0, 0.20, ("west",), 0.5)
+    heavy_e = _windows("heavy", "sterling", 60.0, 0.20, ("east",), 0.5)
+    medium = "medium"
+    return (
+        Case("light", "sanfrancisco", 45.0, 0.25),
+        Case("heavy", "golden", 210.0, 0.20),
+        Case("open_plan", "torino", 330.0, 0.30),
+        Case(*open_w[:4], (open_w[4],), medium),
+        Case("heavy", "torino", 180.0, 0.25, (opaque_solar(DARK_PANEL),), medium),
+        Case("light", "sanfrancisco", 45.0, 0.20, (wind(0.12),), medium),
+        Case("open_plan", "chicago", 120.0, 0.25, (ventilation(1.5),), medium),
+        Case("light", "sterling", 330.0, 0.20, (unmetered(8.0),), medium),
+        Case("light", "golden", 250.0, 0.20, (ground(BARE_SLAB),), medium),
+        Case("heavy", "sanfrancisco", 15.0, 0.25, (sky(BARE_ROOF),), medium),
+        Case("heavy", "chicago", 240.0, 0.25, (thermal_mass(300.0),), medium, "1r1c"),
+        Case("heavy", "golden", 100.0, 0.25, (emitter(70),), medium),
+        Case("open_plan", "sanfrancisco", 210.0, 0.25, (wind(0.2), unmetered(6.0)), medium),
+        Case(*heavy_e[:4], (heavy_e[4], ground(INSULATED_SLAB)), medium),
+    )
+
+
+FRESH_CASES = _fresh_cases()
+# The case sets and the folder each is written to, under data/.
+SETS = {"testbed": CASES, "testbed_fresh": FRESH_CASES}
 
 
 # --- simulation -------------------------------------------------------------------------------
@@ -593,23 +630,29 @@ def make_case(case: Case, out: Path) -> dict:
 
 
 def make_testbed(
-    out: Path, names: Iterable[str] | None = None, jobs: int = 1, log: Log = print
+    out: Path,
+    names: Iterable[str] | None = None,
+    jobs: int = 1,
+    log: Log = print,
+    cases: tuple[Case, ...] = CASES,
 ) -> list[dict]:
-    """Simulate the chosen cases (all by default) ``jobs`` at a time, write them, update the
-    manifest and write the split."""
-    wanted = [c for c in CASES if names is None or c.name in set(names)]
+    """Simulate the chosen ``cases`` (all by default) ``jobs`` at a time, write them, update the
+    manifest and write the split: the seeded draw for the main bed, everything held out for the
+    fresh set (``FRESH_CASES``)."""
+    wanted = [c for c in cases if names is None or c.name in set(names)]
     manifest_path = out / "manifest.json"
     entries = {e["case"]: e for e in _read_json(manifest_path, [])}
     with ProcessPoolExecutor(jobs) as pool:
         for entry in pool.map(make_case, wanted, [out] * len(wanted)):
             entries[entry["case"]] = entry
             log(f"{entry['case']:58s} {_strength_line(entry)}")
-    order = [c.name for c in CASES]
+    order = [c.name for c in cases]
     manifest = sorted(
         (e for e in entries.values() if e["case"] in order), key=lambda e: order.index(e["case"])
     )
     write_json(manifest, manifest_path)
-    write_json(draw_split(manifest), out / "split.json")
+    split = draw_split(manifest) if cases is CASES else all_held_out(manifest)
+    write_json(split, out / "split.json")
     return manifest
 
 
@@ -624,6 +667,16 @@ def _read_json(path: Path, default: object) -> object:
 
 
 # --- split ------------------------------------------------------------------------------------
+
+
+def all_held_out(manifest: Iterable[Mapping]) -> dict:
+    """The fresh set's split: nothing to tune on."""
+    return {
+        "seed": None,
+        "code": "scripts/energyplus/testbed.py: all_held_out",
+        "tuning": [],
+        "heldout": sorted(e["case"] for e in manifest),
+    }
 
 
 def draw_split(manifest: Iterable[Mapping], seed: int = SPLIT_SEED) -> dict:
