@@ -1,9 +1,11 @@
 """Mismatch diagnosis over the test bed of buildings it was never tuned on (issue 11).
 
-    python benchmarks/diagnose_testbed.py [--half tuning|heldout] [--jobs N] [--out DIR] [CASE ...]
+    python benchmarks/diagnose_testbed.py [--set testbed|testbed_fresh] [--half tuning|heldout]
+        [--jobs N] [--out DIR] [CASE ...]
 
 The cases of ``data/testbed/`` (made by ``scripts/make_testbed.py``; ``manifest.json`` says what
-each conceals, ``split.json`` which half it belongs to) are diagnosed ``--jobs`` at a time (default:
+each conceals, ``split.json`` which half it belongs to) — or of the fresh set
+``data/testbed_fresh/``, held out whole — are diagnosed ``--jobs`` at a time (default:
 every core, one worker process each) with the model the manifest names. A case is correct when
 the first accepted finding is its concealed effect; with two concealed effects, when both are
 accepted and the first accepted is one of them; with none, when nothing is accepted (each
@@ -32,7 +34,7 @@ sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 from benchmarks._cases import accepted_effects, diagnose_folder  # noqa: E402
 from rcengine.diagnose import DiagnoseSettings  # noqa: E402
 
-TESTBED = ROOT / "data" / "testbed"
+SETS = ("testbed", "testbed_fresh")
 HALVES = ("tuning", "heldout")
 NONE = "none"
 
@@ -155,20 +157,24 @@ def select(manifest: list[dict], split: dict, half: str | None, names: Sequence[
     ]
 
 
-def _diagnose(entry: dict, out: Path | None, workers: int | None) -> tuple[dict, float]:
+def _diagnose(
+    folder: Path, entry: dict, out: Path | None, workers: int | None
+) -> tuple[dict, float]:
     settings = None if workers is None else DiagnoseSettings(workers=workers)
-    return diagnose_folder(TESTBED / entry["case"], entry["model"], out, False, settings)
+    return diagnose_folder(folder / entry["case"], entry["model"], out, False, settings)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("cases", nargs="*", help="case names (default: all)")
+    parser.add_argument("--set", choices=SETS, default=SETS[0], help="which cases (data/SET)")
     parser.add_argument("--half", choices=HALVES, help="only this half of the split")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="cases at a time")
     parser.add_argument("--out", type=Path, help="folder for the reports and tables")
     args = parser.parse_args()
-    manifest = json.loads((TESTBED / "manifest.json").read_text())
-    split = json.loads((TESTBED / "split.json").read_text())
+    folder = ROOT / "data" / args.set
+    manifest = json.loads((folder / "manifest.json").read_text())
+    split = json.loads((folder / "split.json").read_text())
     chosen = select(manifest, split, args.half, args.cases)
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -177,7 +183,7 @@ def main() -> None:
     started = time.perf_counter()
     results = []
     with ProcessPoolExecutor(args.jobs) as pool:
-        runs = [pool.submit(_diagnose, entry, args.out, workers) for entry, _ in chosen]
+        runs = [pool.submit(_diagnose, folder, entry, args.out, workers) for entry, _ in chosen]
         for (entry, half), run in zip(chosen, runs, strict=True):
             results.append(Result(entry, half, *run.result()))
             print(case_line(results[-1]), flush=True)

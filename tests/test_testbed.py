@@ -24,7 +24,7 @@ from benchmarks.diagnose_testbed import (
 from rcengine.building import Building
 from rcengine.io.timeseries import read_timeseries
 from scripts.energyplus.archetypes import ARCHETYPES
-from scripts.energyplus.testbed import CASES, draw_split
+from scripts.energyplus.testbed import CASES, FRESH_CASES, SETS, draw_split
 from scripts.energyplus.variant import Variant, schedule_clock
 from tests.test_energyplus_io import CONTRACT_HEADER, EFFECTS
 
@@ -45,6 +45,13 @@ def manifest(testbed: Path) -> list[dict]:
 @pytest.fixture(scope="module")
 def split(testbed: Path) -> dict:
     return json.loads((testbed / "split.json").read_text())
+
+
+@pytest.fixture(scope="module", params=sorted(SETS))
+def any_set(request, project_data: Path) -> tuple[Path, list[dict]]:
+    """Each committed set of cases (the main bed, the fresh held-out set) and its manifest."""
+    folder = project_data / request.param
+    return folder, json.loads((folder / "manifest.json").read_text())
 
 
 # --- manifest and split -----------------------------------------------------------------------
@@ -113,7 +120,8 @@ def test_another_seed_draws_another_split(manifest: list[dict], split: dict) -> 
 # --- committed cases --------------------------------------------------------------------------
 
 
-def test_every_case_reads_cleanly_with_daylight_saving(testbed: Path, manifest: list[dict]) -> None:
+def test_every_case_reads_cleanly_with_daylight_saving(any_set: tuple[Path, list[dict]]) -> None:
+    testbed, manifest = any_set
     for entry in manifest:
         folder = testbed / entry["case"]
         building = Building.from_json(folder / "building.json")
@@ -134,7 +142,8 @@ def test_every_case_reads_cleanly_with_daylight_saving(testbed: Path, manifest: 
         assert frame["q_hvac"].max() > 0.0 and frame["q_occ"].max() > 0.0
 
 
-def test_building_json_records_the_rotation(testbed: Path, manifest: list[dict]) -> None:
+def test_building_json_records_the_rotation(any_set: tuple[Path, list[dict]]) -> None:
+    testbed, manifest = any_set
     for entry in manifest:
         building = Building.from_json(testbed / entry["case"] / "building.json")
         facades = sorted(s.azimuth for s in building.walls if s.tilt == 90.0)
@@ -144,9 +153,33 @@ def test_building_json_records_the_rotation(testbed: Path, manifest: list[dict])
         assert glazed == pytest.approx(expected), entry["case"]
 
 
-def test_testbed_fits_in_the_repository(testbed: Path) -> None:
-    size = sum(f.stat().st_size for f in testbed.rglob("*") if f.is_file())
+def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> None:
+    size = sum(f.stat().st_size for f in any_set[0].rglob("*") if f.is_file())
     assert size < 25e6
+
+
+def test_the_fresh_set_is_held_out_whole_and_covers_every_effect_on_new_ground(
+    project_data: Path, manifest: list[dict]
+) -> None:
+    """Every effect once alone at a medium magnitude, strong enough to count; nulls and two-effect
+    cases; a climate and archetype × climate pairs the main bed does not have; no case to tune
+    on."""
+    fresh = project_data / "testbed_fresh"
+    entries = json.loads((fresh / "manifest.json").read_text())
+    assert [e["case"] for e in entries] == [c.name for c in FRESH_CASES]
+    split = json.loads((fresh / "split.json").read_text())
+    assert split["tuning"] == [] and sorted(split["heldout"]) == sorted(e["case"] for e in entries)
+    alone = sorted(e["effects"][0] for e in entries if len(e["effects"]) == 1)
+    assert alone == VOCABULARY
+    assert sum(not e["effects"] for e in entries) >= 3
+    assert sum(len(e["effects"]) == 2 for e in entries) >= 2
+    for e in entries:
+        assert e["magnitude"] == ("medium" if e["effects"] else None)
+        for effect in e["effects"]:
+            assert e["strength"][effect]["rms_t_in_K"] >= MIN_RMS_K, (e["case"], effect)
+    assert {e["climate"] for e in entries} - {e["climate"] for e in manifest}
+    pairs = {(e["archetype"], e["climate"]) for e in manifest}
+    assert any((e["archetype"], e["climate"]) not in pairs for e in entries)
 
 
 # --- generator building blocks ----------------------------------------------------------------

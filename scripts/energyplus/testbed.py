@@ -378,8 +378,8 @@ def _fresh_cases() -> tuple[Case, ...]:
         Case("light", "sterling", 330.0, 0.20, (unmetered(8.0),), medium),
         Case("light", "golden", 250.0, 0.20, (ground(BARE_SLAB),), medium),
         Case("heavy", "sanfrancisco", 15.0, 0.25, (sky(BARE_ROOF),), medium),
-        Case("heavy", "chicago", 240.0, 0.25, (thermal_mass(300.0),), medium, "1r1c"),
-        Case("heavy", "golden", 100.0, 0.25, (emitter(70),), medium),
+        Case("open_plan", "torino", 240.0, 0.25, (thermal_mass(320.0),), medium, "1r1c"),
+        Case("light", "chicago", 160.0, 0.20, (emitter(70),), medium),
         Case("open_plan", "sanfrancisco", 210.0, 0.25, (wind(0.2), unmetered(6.0)), medium),
         Case(*heavy_e[:4], (heavy_e[4], ground(INSULATED_SLAB)), medium),
     )
