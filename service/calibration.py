@@ -211,11 +211,13 @@ def fit_parameter_set(
         check_columns(spec, training.columns)
         network, signals, model = spec.network(building), spec.signals, spec.name
     data = prepare(training, building, network.compile().input_names, signals)
+    # The set records its parameters on bounds (``fit.at_bounds``), which promotion reads.
     estimator = Estimator(
         network,
         preset=options.preset,
         random_state=options.random_state,
         criterion=options.criterion,
+        warn_bounds=False,
     )
     estimator.fit(data)
     return ParameterSet.from_estimator(estimator, data, building, model, signals)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -15,7 +14,6 @@ from rcengine.diagnose.folds import Fold
 from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
 from rcengine.estimation.presets import EstimatorSettings
-from rcengine.exceptions import ConvergenceWarning
 from rcengine.kalman import kalman_filter
 from rcengine.metrics import rmse
 from rcengine.network import CompiledNetwork, RCNetwork
@@ -130,11 +128,14 @@ def fit_model(
 ) -> Fit:
     """Calibrate on ``split.train`` (within ``bounds``, default the network's); simulate the
     test period on from the training period (``carried_on``) and filter both for innovations."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(
-            network, preset=preset, random_state=random_state, warm_start=warm_start, bounds=bounds
-        ).fit(split.train)
+    est = Estimator(
+        network,
+        preset=preset,
+        random_state=random_state,
+        warm_start=warm_start,
+        bounds=bounds,
+        warn_bounds=False,
+    ).fit(split.train)
     compiled = est.compiled
     simulated_test = carried_on(compiled, est.params_, split)
     y_train, y_test = split.train.measured, split.test.measured

@@ -10,7 +10,6 @@ from the current parameters.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +22,6 @@ from rcengine.diagnose.response import node_responses
 from rcengine.estimation import Estimator, EstimatorSettings
 from rcengine.estimation.ga import GASettings
 from rcengine.estimation.pattern_search import GPSSettings
-from rcengine.exceptions import ConvergenceWarning
 
 LOCAL_REFIT = EstimatorSettings(
     GASettings(population=16, generations=4, lhs=True),
@@ -72,14 +70,13 @@ def _projection(ext: Extension, base: Fit, train: Dataset) -> Screen:
 
 
 def _local_refit(ext: Extension, base: Fit, split: Split, random_state: int) -> Screen:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(
-            ext.network,
-            preset=LOCAL_REFIT,
-            random_state=random_state,
-            warm_start=[{**base.params, **ext.neutral}, dict(base.params)],
-        ).fit(split.train)
+    est = Estimator(
+        ext.network,
+        preset=LOCAL_REFIT,
+        random_state=random_state,
+        warm_start=[{**base.params, **ext.neutral}, dict(base.params)],
+        warn_bounds=False,
+    ).fit(split.train)
     y = split.train.measured
     resid = y - est.trajectory_.y
     mask = np.isfinite(resid) & np.isfinite(base.residual_train)

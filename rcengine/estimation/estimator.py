@@ -111,6 +111,10 @@ class Estimator:
         noise estimated with the parameters, by maximum likelihood (``preset.likelihood``
         settings; ``ga``, ``gps`` and ``polish`` do not apply; ``cost_`` is −ln L).
     initial : for "likelihood", the initial state "diffuse" (default) or "estimated".
+    warn_bounds : warn (``ConvergenceWarning``) when a parameter ends on a bound; False for a
+        caller that reads ``at_bounds_`` and reports it itself (a warning silenced around the call
+        instead would not stay silenced: ``warnings.catch_warnings`` is process-wide state, and
+        another thread leaving it restores the filters under a fit still running).
 
     Attributes (after ``fit``)
     --------------------------
@@ -137,6 +141,7 @@ class Estimator:
     warm_start: list[Mapping[str, float]] | None = None
     criterion: str = "output_error"
     initial: str = "diffuse"
+    warn_bounds: bool = True
 
     @property
     def compiled(self) -> CompiledNetwork:
@@ -176,7 +181,7 @@ class Estimator:
             self.likelihood_.evaluations if self.likelihood_ else 0
         )
         self.wall_time_s_ = time.perf_counter() - started
-        if self.at_bounds_:
+        if self.at_bounds_ and self.warn_bounds:
             warnings.warn(
                 f"{network.name}: parameter(s) {self.at_bounds_} ended on a bound; "
                 "widen the bounds or question the model structure",

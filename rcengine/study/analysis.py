@@ -4,15 +4,12 @@ validation of thesis §3.3."""
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
 from rcengine.columns import GHI, SOLAR_OPAQUE, SOLAR_WINDOW, T_IN
 from rcengine.estimation import Estimator, EstimatorSettings
-from rcengine.exceptions import ConvergenceWarning
 from rcengine.forecast import forecast
 from rcengine.metrics import evaluate
 from rcengine.models import get_model
@@ -207,9 +204,9 @@ def free_floating(
     day0 = pd.Timestamp(start).tz_localize(tz)
     train = data.between(day0 - pd.Timedelta(days=learn_days), day0)
     net = get_model(model, building, frame.columns)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(net, preset=preset, random_state=0, criterion=criterion).fit(train)
+    est = Estimator(net, preset=preset, random_state=0, criterion=criterion, warn_bounds=False).fit(
+        train
+    )
     fc = forecast(est.compiled, est.params_, data, day0, hours=24 * predict_days, noise=est.noise_)
     measured = data.frame[T_IN].reindex(fc.times).to_numpy(dtype=float)
     metrics = evaluate(measured, fc.t_in_pred).to_dict()

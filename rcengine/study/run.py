@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import os
 import time
-import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -25,7 +24,6 @@ from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
 from rcengine.dataset import Dataset
 from rcengine.estimation import Estimator, EstimatorSettings
-from rcengine.exceptions import ConvergenceWarning
 from rcengine.forecast import forecast
 from rcengine.io.instants import parse_instant
 from rcengine.kalman import Noise
@@ -148,11 +146,9 @@ def learn_and_predict(
     """Fit on the ``past`` days by ``criterion``, forecast the ``ahead`` days."""
     # CPU time beside wall time: other processes sharing the cores inflate only the latter.
     started, started_cpu = time.perf_counter(), time.process_time()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        est = Estimator(network, preset=preset, random_state=random_state, criterion=criterion).fit(
-            data.on_days(past)
-        )
+    est = Estimator(
+        network, preset=preset, random_state=random_state, criterion=criterion, warn_bounds=False
+    ).fit(data.on_days(past))
     wall, cpu = time.perf_counter() - started, time.process_time() - started_cpu
     times, predicted, measured = _forecast_days(est.compiled, est.params_, data, ahead, est.noise_)
     return Prediction(est, wall, cpu, times, predicted, measured)
