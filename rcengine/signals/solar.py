@@ -447,7 +447,7 @@ def _month_middles(leap: bool) -> np.ndarray:
     lengths = np.array(calendar.mdays[1:], dtype=float)
     lengths[1] += leap
     middles = np.cumsum(lengths) - lengths / 2.0
-    return np.concatenate([[-15.5], middles, [lengths.sum() + 15.5]])
+    return np.concatenate([[-lengths[11] / 2.0], middles, [lengths.sum() + lengths[0] / 2.0]])
 
 
 def clear_sky_ghi(times: pd.DatetimeIndex, location: Location) -> np.ndarray:
