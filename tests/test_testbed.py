@@ -24,7 +24,15 @@ from benchmarks.diagnose_testbed import (
 from rcengine.building import Building
 from rcengine.io.timeseries import read_timeseries
 from scripts.energyplus.archetypes import ARCHETYPES
-from scripts.energyplus.testbed import CASES, FRESH_CASES, SETS, draw_split
+from scripts.energyplus.testbed import (
+    CASES,
+    FRESH_CASES,
+    SEALED_CASES,
+    SEALED_SEED,
+    SETS,
+    draw_split,
+    sealed_cases,
+)
 from scripts.energyplus.variant import Variant, schedule_clock
 from tests.test_energyplus_io import CONTRACT_HEADER, EFFECTS
 
@@ -158,28 +166,42 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
     assert size < 25e6
 
 
-def test_the_fresh_set_is_held_out_whole_and_covers_every_effect_on_new_ground(
-    project_data: Path, manifest: list[dict]
+@pytest.mark.parametrize(
+    ("name", "cases", "magnitude"),
+    [("testbed_fresh", FRESH_CASES, "medium"), ("testbed_sealed", SEALED_CASES, "drawn")],
+)
+def test_a_further_set_is_held_out_whole_and_covers_every_effect(
+    project_data: Path, name: str, cases: tuple, magnitude: str
 ) -> None:
-    """Every effect once alone at a medium magnitude, strong enough to count; nulls and two-effect
-    cases; a climate and archetype × climate pairs the main bed does not have; no case to tune
-    on."""
-    fresh = project_data / "testbed_fresh"
-    entries = json.loads((fresh / "manifest.json").read_text())
-    assert [e["case"] for e in entries] == [c.name for c in FRESH_CASES]
-    split = json.loads((fresh / "split.json").read_text())
+    """The fresh and the sealed sets: every effect once alone, strong enough to count; nulls
+    and two-effect cases; no case to tune on."""
+    folder = project_data / name
+    entries = json.loads((folder / "manifest.json").read_text())
+    assert [e["case"] for e in entries] == [c.name for c in cases]
+    split = json.loads((folder / "split.json").read_text())
     assert split["tuning"] == [] and sorted(split["heldout"]) == sorted(e["case"] for e in entries)
     alone = sorted(e["effects"][0] for e in entries if len(e["effects"]) == 1)
     assert alone == VOCABULARY
     assert sum(not e["effects"] for e in entries) >= 3
     assert sum(len(e["effects"]) == 2 for e in entries) >= 2
     for e in entries:
-        assert e["magnitude"] == ("medium" if e["effects"] else None)
+        assert e["magnitude"] == (magnitude if e["effects"] else None)
         for effect in e["effects"]:
             assert e["strength"][effect]["rms_t_in_K"] >= MIN_RMS_K, (e["case"], effect)
+
+
+def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[dict]) -> None:
+    """A climate and archetype × climate pairs the main bed does not have."""
+    entries = json.loads((project_data / "testbed_fresh" / "manifest.json").read_text())
     assert {e["climate"] for e in entries} - {e["climate"] for e in manifest}
     pairs = {(e["archetype"], e["climate"]) for e in manifest}
     assert any((e["archetype"], e["climate"]) not in pairs for e in entries)
+
+
+def test_the_sealed_set_is_the_seeds_draw() -> None:
+    """Drawn, not chosen: the committed cases are the seed's, and another seed draws others."""
+    assert sealed_cases(SEALED_SEED) == SEALED_CASES
+    assert [c.name for c in sealed_cases(SEALED_SEED + 1)] != [c.name for c in SEALED_CASES]
 
 
 # --- generator building blocks ----------------------------------------------------------------

@@ -24,7 +24,9 @@ well above it.
 
 ``draw_split`` assigns the cases to a tuning and a held-out half by a seeded draw, stratified so
 that each half has null, one-effect and two-effect cases and one of each effect's weak/strong
-pair. Entry point: ``python scripts/make_testbed.py``.
+pair. Two further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once) and
+``SEALED_CASES`` (drawn from a seed, not yet diagnosed). Entry point:
+``python scripts/make_testbed.py [--set testbed_fresh|testbed_sealed]``.
 """
 
 from __future__ import annotations
@@ -392,7 +394,7 @@ SEALED_SEED = 20261124
 SINGLE_STOREY = ("light", "open_plan")
 
 
-def _sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
+def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
     """A third set for a later session to judge a change on, drawn at random rather than chosen
     (after the fresh set's results were known): per effect an archetype, climate, orientation,
     ordinary glazing and a magnitude from the middle to the top of the main bed's range; three
@@ -460,7 +462,7 @@ def _sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
     return tuple(cases.values())
 
 
-SEALED_CASES = _sealed_cases()
+SEALED_CASES = sealed_cases()
 # The case sets and the folder each is written to, under data/.
 SETS = {"testbed": CASES, "testbed_fresh": FRESH_CASES, "testbed_sealed": SEALED_CASES}
 
