@@ -33,8 +33,8 @@ sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
 from benchmarks._cases import accepted_effects, diagnose_folder  # noqa: E402
 from rcengine.diagnose import DiagnoseSettings  # noqa: E402
+from scripts.energyplus.testbed import SETS  # noqa: E402
 
-SETS = ("testbed", "testbed_fresh", "testbed_sealed")
 HALVES = ("tuning", "heldout")
 NONE = "none"
 
@@ -167,7 +167,7 @@ def _diagnose(
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("cases", nargs="*", help="case names (default: all)")
-    parser.add_argument("--set", choices=SETS, default=SETS[0], help="which cases (data/SET)")
+    parser.add_argument("--set", choices=SETS, default="testbed", help="which cases (data/SET)")
     parser.add_argument("--half", choices=HALVES, help="only this half of the split")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="cases at a time")
     parser.add_argument("--out", type=Path, help="folder for the reports and tables")

@@ -32,15 +32,16 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--only",
         nargs="+",
-        choices=sorted(c.name for cases in SETS.values() for c in cases),
-        help="regenerate only these cases",
+        choices=sorted({c.name for cases, _ in SETS.values() for c in cases}),
+        metavar="CASE",
+        help="regenerate only these cases of the set",
     )
     parser.add_argument("--jobs", type=int, default=1, help="cases simulated at a time")
     parser.add_argument("--out", type=Path, help="output directory (default: data/SET)")
     args = parser.parse_args(argv)
     out = args.out or ROOT / "data" / args.set
     started = time.perf_counter()
-    make_testbed(out, args.only, args.jobs, cases=SETS[args.set])
+    make_testbed(out, *SETS[args.set], args.only, args.jobs)
     print(f"done in {time.perf_counter() - started:.1f} s -> {out}")
 
 

@@ -463,8 +463,6 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 
 
 SEALED_CASES = sealed_cases()
-# The case sets and the folder each is written to, under data/.
-SETS = {"testbed": CASES, "testbed_fresh": FRESH_CASES, "testbed_sealed": SEALED_CASES}
 
 
 # --- simulation -------------------------------------------------------------------------------
@@ -708,14 +706,15 @@ def make_case(case: Case, out: Path) -> dict:
 
 def make_testbed(
     out: Path,
+    cases: tuple[Case, ...],
+    split: Callable[[list[dict]], dict],
     names: Iterable[str] | None = None,
     jobs: int = 1,
     log: Log = print,
-    cases: tuple[Case, ...] = CASES,
 ) -> list[dict]:
     """Simulate the chosen ``cases`` (all by default) ``jobs`` at a time, write them, update the
-    manifest and write the split: the seeded draw for the main bed, everything held out for the
-    fresh set (``FRESH_CASES``)."""
+    manifest and write its ``split`` (``SETS``: the seeded draw for the main bed, everything held
+    out for the further sets)."""
     wanted = [c for c in cases if names is None or c.name in set(names)]
     manifest_path = out / "manifest.json"
     entries = {e["case"]: e for e in _read_json(manifest_path, [])}
@@ -728,8 +727,7 @@ def make_testbed(
         (e for e in entries.values() if e["case"] in order), key=lambda e: order.index(e["case"])
     )
     write_json(manifest, manifest_path)
-    split = draw_split(manifest) if cases is CASES else all_held_out(manifest)
-    write_json(split, out / "split.json")
+    write_json(split(manifest), out / "split.json")
     return manifest
 
 
@@ -781,3 +779,11 @@ def draw_split(manifest: Iterable[Mapping], seed: int = SPLIT_SEED) -> dict:
         "tuning": sorted(halves[0]),
         "heldout": sorted(halves[1]),
     }
+
+
+# Each set of cases by the folder it is written to, under data/, with the split it gets.
+SETS: dict[str, tuple[tuple[Case, ...], Callable[[list[dict]], dict]]] = {
+    "testbed": (CASES, draw_split),
+    "testbed_fresh": (FRESH_CASES, all_held_out),
+    "testbed_sealed": (SEALED_CASES, all_held_out),
+}
