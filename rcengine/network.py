@@ -239,9 +239,10 @@ class RCNetwork:
         equations: a heat input of zero gain and a resistor of infinite resistance (an open
         circuit) are removed; a capacity of zero makes its node massless; a resistor of zero
         resistance (a short circuit) joins a massless node to its neighbour, which takes its
-        resistors and heat inputs. A node nothing connects any more leaves, with the heat into
-        it (none of which could reach another node), and so does a boundary temperature, a signal
-        or a parameter nothing uses any more."""
+        resistors and heat inputs. A node no resistor joins to the output any more leaves, with
+        the heat into it and the capacitors and resistors beyond it (none of which could reach the
+        output), and so does a boundary temperature, a signal or a parameter nothing uses any
+        more."""
         unknown = [p for p in values if p not in self.parameters]
         if unknown:
             raise ModelError(f"{self.name} has no parameter(s) {unknown}")
@@ -309,13 +310,23 @@ class RCNetwork:
             self.output = kept
 
     def _drop_unconnected(self) -> None:
-        """Remove nodes without a resistor (the output aside) and boundaries nothing touches."""
-        ends = {end for r in self.resistors for end in (r.a, r.b)}
-        alone = {n for n in self.nodes if n not in ends and n != self.output}
-        self.capacitors = [c for c in self.capacitors if c.node not in alone]
-        self.massless = [n for n in self.massless if n not in alone]
-        self.heat_inputs = [h for h in self.heat_inputs if h.node not in alone]
-        self.temperatures = [t for t in self.temperatures if t in ends]
+        """Remove the nodes no resistive path joins to the output (without passing through a
+        prescribed temperature, whose value no node changes) and the boundaries nothing touches
+        any more: what happens in them can never reach the measured temperature."""
+        reached, frontier = {self.output}, [self.output]
+        while frontier:
+            node = frontier.pop()
+            for r in self.resistors:
+                other = r.b if r.a == node else r.a if r.b == node else None
+                if other is not None and other not in reached:
+                    reached.add(other)
+                    if other not in self.temperatures:
+                        frontier.append(other)
+        self.resistors = [r for r in self.resistors if r.a in reached and r.b in reached]
+        self.capacitors = [c for c in self.capacitors if c.node in reached]
+        self.massless = [n for n in self.massless if n in reached]
+        self.heat_inputs = [h for h in self.heat_inputs if h.node in reached]
+        self.temperatures = [t for t in self.temperatures if t in reached]
 
     def _check_value(self, value: Value) -> None:
         if isinstance(value, str):

@@ -203,3 +203,25 @@ def test_a_resistor_fixed_at_infinity_is_an_open_circuit_and_its_boundary_leaves
     np.testing.assert_allclose(B, B_none, rtol=1e-12)
     with pytest.raises(ModelError, match="finite"):
         net.fixed({"c1": np.inf})
+
+
+def test_a_branch_an_open_circuit_cuts_off_leaves_whole():
+    """A floor fixed open (r = ∞) cuts off the soil layer behind it: the soil's capacity, its
+    own resistor to the ground, the heat into it and the ground temperature all leave, since
+    nothing there can reach the output any more; the network is the one without the floor."""
+    net = two_node()
+    net.add_parameter(Parameter("r_floor", "m²K/W", 0.1, 20.0))
+    net.add_parameter(Parameter("d_soil", "m", 0.05, 6.0))
+    net.add_parameter(Parameter("q_ground", "W/m²", -20.0, 60.0))
+    net.add_capacitor("soil", "d_soil", factor=2e6)
+    net.add_resistor("wall", "soil", "r_floor")
+    net.add_resistor("soil", "t_ground", "d_soil", factor=0.5)
+    net.add_heat_input("unit", "soil", "q_ground")
+    opened = net.fixed({"r_floor": np.inf, "q_ground": 0.0})
+    assert opened.states == two_node().states and "d_soil" not in opened.parameters
+    assert opened.compile().input_names == two_node().compile().input_names
+    values = {"r1": 0.02, "r2": 0.01, "c1": 3e5, "c2": 2e6, "g": 7.0}
+    A, B, _, _ = opened.compile().state_space(values)
+    A_none, B_none, _, _ = two_node().compile().state_space(values)
+    np.testing.assert_allclose(A, A_none, rtol=1e-12)
+    np.testing.assert_allclose(B, B_none, rtol=1e-12)

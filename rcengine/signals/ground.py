@@ -23,10 +23,13 @@ from scipy.signal import lfilter
 GROUND_TAU_DAYS = 30.0
 # Annual period. [s]
 YEAR_S = 365.2425 * 86400.0
-# Periodic penetration depth of the annual wave in sand or gravel, λ = 2.0 W/(mK), ρc = 2.0e6
-# J/(m³K): ISO 13370:2017 Table 7 (δ = 3.2 m; 2.2 m in clay, 4.2 m in rock); the standard's
-# soil when the soil is unknown. [m]
-SOIL_PENETRATION_DEPTH_M = 3.2
+# Sand or gravel, the soil ISO 13370:2017 (Table 7) and ISO 52016-1 take when the soil is
+# unknown: conductivity [W/(mK)] and volumetric heat capacity [J/(m³K)].
+SOIL_CONDUCTIVITY = 2.0
+SOIL_HEAT_CAPACITY = 2.0e6
+# Periodic penetration depth of the annual wave, δ = √(λ·P/(π·ρc)) (ISO 13370:2017 Table 7:
+# 3.2 m in sand or gravel; 2.2 m in clay, 4.2 m in rock). [m]
+SOIL_PENETRATION_DEPTH_M = float(np.sqrt(SOIL_CONDUCTIVITY * YEAR_S / (np.pi * SOIL_HEAT_CAPACITY)))
 # Lag of a slab floor's ground heat flow behind the outdoor annual cycle: about a month (the phase
 # shift β of ISO 13370's periodic method for slab-on-ground floors, 0.7–1 month). [s]
 GROUND_LAG_S = YEAR_S / 12.0

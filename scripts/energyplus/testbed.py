@@ -392,6 +392,9 @@ SEALED_SEED = 20261124
 # Archetypes a drawn effect may go on: a radiant floor needs a single storey on the ground, and
 # 300 m² of concrete barely changes the heavy archetype (0.23 K, FRESH_CASES).
 SINGLE_STOREY = ("light", "open_plan")
+# Effects drawn on a single storey alone, and never paired: each is the whole of its case's
+# missing structure (the added storage is judged on the 1R1C, the emitter on a radiant floor).
+STRUCTURAL = ("thermal_mass", "emitter_dynamics")
 
 
 def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
@@ -437,7 +440,7 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
     while len(cases) < 3:
         add(Case(*where()))
     for effect in vocabulary:
-        single = effect in ("thermal_mass", "emitter_dynamics")
+        single = effect in STRUCTURAL
         archetype, climate, rotation, wwr = where(
             SINGLE_STOREY if single else tuple(sorted(ARCHETYPES))
         )
@@ -453,7 +456,7 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
                 model,
             )
         )
-    pairs = [e for e in vocabulary if e not in ("thermal_mass", "emitter_dynamics")]
+    pairs = [e for e in vocabulary if e not in STRUCTURAL]
     while sum(len(c.effects) == 2 for c in cases.values()) < 2:
         first, second = rng.sample(pairs, 2)
         archetype, climate, rotation, wwr = where()
