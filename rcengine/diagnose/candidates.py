@@ -63,7 +63,11 @@ from rcengine.models.physical import steady_share
 from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.derived import indoor_operating_point
-from rcengine.signals.ground import annual_cycle, seasonal_ground_temperature
+from rcengine.signals.ground import (
+    annual_cycle,
+    annual_mean_uncertainty,
+    seasonal_ground_temperature,
+)
 from rcengine.signals.schedules import (
     CLOCKS,
     N_DAY_TYPES,
@@ -623,13 +627,16 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
 
 def _ground_temperatures(ctx: Context) -> dict[str, float]:
     """What the fitted ground temperature is judged against, over the training period [°C]: the
-    mean of T_base, the outdoor annual mean and the mean indoor temperature."""
+    mean of T_base, the outdoor annual mean (with its standard error [K]) and the mean indoor
+    temperature."""
     times, t_out = ctx.data.times, ctx.train[T_OUT].to_numpy(dtype=float)
     latitude = ctx.building.location.latitude
-    base = seasonal_ground_temperature(times, t_out, latitude)
+    cycle = annual_cycle(times, t_out, latitude)
+    base = seasonal_ground_temperature(times, t_out, latitude, cycle=cycle)
     return {
         "ground_base_c": float(np.mean(base)),
-        "outdoor_mean_c": float(annual_cycle(times, t_out, latitude).mean),
+        "outdoor_mean_c": float(cycle.mean),
+        "outdoor_mean_se_k": annual_mean_uncertainty(times, t_out, cycle),
         "indoor_mean_c": float(np.nanmean(ctx.data.measured)),
     }
 

@@ -36,6 +36,7 @@ from rcengine.models.bounds import (
     U_OPAQUE,
 )
 from rcengine.models.physical import solar_apertures, steady_state_gains, ua
+from rcengine.signals.ground import ESTIMATE_Z
 
 if TYPE_CHECKING:
     from rcengine.diagnose.candidates import Extension
@@ -67,7 +68,9 @@ U_FLOOR: Range = (0.05, U_GROUND_MAX)
 # from the one to the other, ISO 13370): the building warms it in winter and shades it in summer,
 # so over a period it is no colder than both the undisturbed soil at the slab's depth then (the
 # damped, lagged annual wave, below the annual mean in winter) and the annual mean. The margin
-# covers their estimates. [K]
+# covers the wave's depth and soil (δ from 2.2 m in clay to 4.2 m in rock, ISO 13370 Table 7);
+# the annual mean's own error, read from a few months of weather, is added to it
+# (``annual_mean_uncertainty``). [K]
 GROUND_TEMPERATURE_MARGIN_K = 2.0
 # Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
 # −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
@@ -275,7 +278,11 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     d = ext.detail
     r = params["r_floor"]
     t_ground = d["ground_base_c"] + params["q_ground"] * r
-    low = min(d["ground_base_c"], d["outdoor_mean_c"]) - GROUND_TEMPERATURE_MARGIN_K
+    low = (
+        min(d["ground_base_c"], d["outdoor_mean_c"])
+        - GROUND_TEMPERATURE_MARGIN_K
+        - ESTIMATE_Z * d["outdoor_mean_se_k"]
+    )
     high = d["indoor_mean_c"] + GROUND_TEMPERATURE_MARGIN_K
     return [
         Reading("u_floor", 1.0 / r, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),

@@ -43,6 +43,8 @@ COLDEST_DAY_OF_YEAR = 15.0
 # this much (about two months away from the coldest day): nearer, mean and amplitude are one
 # number. [-]
 MIN_CYCLE_SPREAD = 0.5
+# Two-sided 95 % normal quantile: how far below an estimate a bound read from it may lie. [-]
+ESTIMATE_Z = 1.96
 # Largest annual amplitude of monthly mean air temperatures on Earth (≈ 30 K in eastern Siberia);
 # a fit beyond it is the weather of one record, not a climate. [K]
 MAX_ANNUAL_AMPLITUDE_K = 30.0
@@ -115,6 +117,39 @@ def annual_cycle(times: pd.DatetimeIndex, t_out: np.ndarray, latitude: float) ->
         amplitude = np.linalg.lstsq(design, t_out[ok], rcond=None)[0][1]
     amplitude = float(np.clip(amplitude, 0.0, MAX_ANNUAL_AMPLITUDE_K))
     return AnnualCycle(float(np.mean(t_out[ok] + amplitude * shape)), amplitude, coldest)
+
+
+def annual_mean_uncertainty(
+    times: pd.DatetimeIndex, t_out: np.ndarray, cycle: AnnualCycle
+) -> float:
+    """Standard error of ``cycle.mean`` as the annual mean of the weather. [K]
+
+    A record of a few months reads the annual mean through its fitted cycle, and a mild or harsh
+    spell moves it: from October–January of the TMY3 files that ship with EnergyPlus, Chicago's
+    mean comes out 2.2 K above its full year's, Golden's 1.0 K below. The scatter of the daily
+    means about the cycle gives the error of the least-squares mean, σ²·[(XᵀX)⁻¹]₀₀ with X the
+    design [1, −cos(2π(t − t_cold)/year)] (only [1] when the cycle is flat), counting weather
+    spells, not days: n(1 − ρ₁)/(1 + ρ₁) independent days for a lag-1 autocorrelation ρ₁ of the
+    daily scatter (synoptic systems last several days). Returns ``inf`` for fewer than three
+    days: such a record says nothing of the year.
+    """
+    series = pd.Series(np.asarray(t_out, dtype=float), index=times).dropna()
+    daily = series.resample("1D").mean().dropna()
+    n = len(daily)
+    if n < 3:
+        return float("inf")
+    shape = np.cos(cycle.phase(daily.index + pd.Timedelta(hours=12)))
+    residual = daily.to_numpy() - (cycle.mean - cycle.amplitude * shape)
+    design = np.column_stack([np.ones(n), -shape]) if cycle.amplitude > 0 else np.ones((n, 1))
+    k = design.shape[1]
+    if n <= k + 1:
+        return float("inf")
+    rho = float(np.corrcoef(residual[:-1], residual[1:])[0, 1]) if residual.std() > 0 else 0.0
+    rho = min(max(rho, 0.0), 0.99)
+    n_eff = n * (1.0 - rho) / (1.0 + rho)
+    variance = float(residual @ residual) / (n - k)
+    covariance = variance * np.linalg.inv(design.T @ design) * n / n_eff
+    return float(np.sqrt(covariance[0, 0]))
 
 
 def seasonal_ground_temperature(
