@@ -1,17 +1,17 @@
 """Mismatch diagnosis over the test bed of buildings it was never tuned on (issue 11).
 
-    python benchmarks/diagnose_testbed.py [--set testbed|testbed_fresh|testbed_sealed]
+    python benchmarks/diagnose_testbed.py [--set testbed|testbed_fresh|testbed_sealed|...]
         [--half tuning|heldout] [--jobs N] [--out DIR] [CASE ...]
 
 The cases of ``data/testbed/`` (made by ``scripts/make_testbed.py``; ``manifest.json`` says what
-each conceals, ``split.json`` which half it belongs to) — or of the fresh or the sealed set,
-``data/testbed_fresh/`` and ``data/testbed_sealed/``, each held out whole — are diagnosed
-``--jobs`` at a time (default: every core, one worker process each) with the model the manifest
-names. A case is correct when the first accepted finding is its concealed effect; with two
-concealed effects, when both are accepted and the first accepted is one of them; with none, when
-nothing is accepted (each accepted finding on a null case is a false finding). Only the
-held-out half counts. ``--out`` writes each JSON report, ``confusion.md`` (true effect × first
-finding) and ``tables.md`` (results per archetype and per climate). Last line: JSON {"cases",
+each conceals, ``split.json`` which half it belongs to) — or of a further set,
+``data/testbed_fresh/``, ``data/testbed_sealed/`` or ``data/testbed_sealed_2/``, each held out
+whole — are diagnosed ``--jobs`` at a time (default: every core, one worker process each) with
+the model the manifest names. A case is correct when the first accepted finding is its concealed
+effect; with two concealed effects, when both are accepted and the first accepted is one of them;
+with none, when nothing is accepted (each accepted finding on a null case is a false finding).
+Only the held-out half counts. ``--out`` writes each JSON report, ``confusion.md`` (true effect ×
+first finding) and ``tables.md`` (results per archetype and per climate). Last line: JSON {"cases",
 "heldout_cases", "heldout_correct", "tuning_correct", "null_false_findings",
 "two_effect_both_found", "wall_s_per_case"}.
 """

@@ -5,7 +5,8 @@
     python scripts/make_testbed.py --only light-torino-null # some cases (manifest updated)
     python scripts/make_testbed.py --out /tmp/testbed       # elsewhere
     python scripts/make_testbed.py --set testbed_fresh      # the fresh held-out set
-    python scripts/make_testbed.py --set testbed_sealed     # the sealed set (drawn, undiagnosed)
+    python scripts/make_testbed.py --set testbed_sealed     # the sealed set (drawn)
+    python scripts/make_testbed.py --set testbed_sealed_2   # the next one (drawn, undiagnosed)
 
 Writes ``<case>/data.csv`` and ``<case>/building.json`` per case, ``manifest.json`` (archetype,
 climate, rotation, concealed effects with their physical magnitudes and measured strengths) and

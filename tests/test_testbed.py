@@ -27,6 +27,8 @@ from scripts.energyplus.archetypes import ARCHETYPES
 from scripts.energyplus.testbed import (
     CASES,
     FRESH_CASES,
+    SEALED_2_CASES,
+    SEALED_2_SEED,
     SEALED_CASES,
     SEALED_SEED,
     SETS,
@@ -168,7 +170,11 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
 
 @pytest.mark.parametrize(
     ("name", "cases", "magnitude"),
-    [("testbed_fresh", FRESH_CASES, "medium"), ("testbed_sealed", SEALED_CASES, "drawn")],
+    [
+        ("testbed_fresh", FRESH_CASES, "medium"),
+        ("testbed_sealed", SEALED_CASES, "drawn"),
+        ("testbed_sealed_2", SEALED_2_CASES, "drawn"),
+    ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
     project_data: Path, name: str, cases: tuple, magnitude: str
@@ -198,10 +204,11 @@ def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[d
     assert any((e["archetype"], e["climate"]) not in pairs for e in entries)
 
 
-def test_the_sealed_set_is_the_seeds_draw() -> None:
-    """Drawn, not chosen: the committed cases are the seed's, and another seed draws others."""
+def test_the_sealed_sets_are_their_seeds_draws() -> None:
+    """Drawn, not chosen: the committed cases are the seeds', and the two seeds draw others."""
     assert sealed_cases(SEALED_SEED) == SEALED_CASES
-    assert [c.name for c in sealed_cases(SEALED_SEED + 1)] != [c.name for c in SEALED_CASES]
+    assert sealed_cases(SEALED_2_SEED) == SEALED_2_CASES
+    assert [c.name for c in SEALED_2_CASES] != [c.name for c in SEALED_CASES]
 
 
 # --- generator building blocks ----------------------------------------------------------------

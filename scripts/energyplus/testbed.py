@@ -24,9 +24,10 @@ well above it.
 
 ``draw_split`` assigns the cases to a tuning and a held-out half by a seeded draw, stratified so
 that each half has null, one-effect and two-effect cases and one of each effect's weak/strong
-pair. Two further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once) and
-``SEALED_CASES`` (drawn from a seed, not yet diagnosed). Entry point:
-``python scripts/make_testbed.py [--set testbed_fresh|testbed_sealed]``.
+pair. Further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once),
+``SEALED_CASES`` (drawn from a seed, diagnosed once) and ``SEALED_2_CASES`` (drawn from the next
+seed, not yet diagnosed). Entry point:
+``python scripts/make_testbed.py [--set testbed_fresh|testbed_sealed|testbed_sealed_2]``.
 """
 
 from __future__ import annotations
@@ -466,6 +467,9 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 
 
 SEALED_CASES = sealed_cases()
+# The next sealed set, drawn once the first was spent: the same draw from the next seed.
+SEALED_2_SEED = SEALED_SEED + 1
+SEALED_2_CASES = sealed_cases(SEALED_2_SEED)
 
 
 # --- simulation -------------------------------------------------------------------------------
@@ -789,4 +793,5 @@ SETS: dict[str, tuple[tuple[Case, ...], Callable[[list[dict]], dict]]] = {
     "testbed": (CASES, draw_split),
     "testbed_fresh": (FRESH_CASES, all_held_out),
     "testbed_sealed": (SEALED_CASES, all_held_out),
+    "testbed_sealed_2": (SEALED_2_CASES, all_held_out),
 }
