@@ -10,6 +10,9 @@ seasonal swing (Kusuda & Achenbach 1965). Two estimates:
   diagnosis fits the mean on top of it (a heated building warms the soil under it);
 - ``ground_temperature``: an exponentially weighted running mean of the outdoor temperature (a
   month's time constant), the older, shorter-memory estimate.
+
+``annual_mean_uncertainty`` says how well a record of a few months knows the annual mean it reads:
+a bound on the soil temperature read from it must be as loose as the mean is uncertain.
 """
 
 from __future__ import annotations
