@@ -22,6 +22,7 @@ candidates are still judged against it, and the verdict says so.
 from __future__ import annotations
 
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -508,10 +509,10 @@ def _confirm_on_folds(
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
-    problem.say(
-        f"  confirming {', '.join(e.effect for e, _ in passing)} on {len(problem.folds)} "
-        "rolling folds"
-    )
+    # A learnt schedule and its refinement are two versions of one effect.
+    counts = Counter(e.effect for e, _ in passing)
+    names = [f"{e} ({n} versions)" if n > 1 else e for e, n in counts.items()]
+    problem.say(f"  confirming {', '.join(names)} on {len(problem.folds)} rolling folds")
     fits = _fold_fits_beside_current(problem, state, models)
     before = tuple(f.residual_test for f in state.current_folds)
     for (_, finding), fold_fits in zip(passing, fits, strict=True):
