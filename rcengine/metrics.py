@@ -16,6 +16,20 @@ ASHRAE14_CV_RMSE_MAX = 30.0
 ASHRAE14_NMBE_MAX = 10.0
 
 
+def lag1_autocorrelation(errors: ArrayLike) -> float:
+    """Correlation of consecutive errors (finite values, in order); 0 for fewer than three or a
+    constant series."""
+    e = np.asarray(errors, dtype=float)
+    e = e[np.isfinite(e)]
+    return float(np.corrcoef(e[:-1], e[1:])[0, 1]) if e.size > 2 and e.std() > 0 else 0.0
+
+
+def effective_count(n: float, rho: float) -> float:
+    """How many independent values ``n`` values with lag-1 autocorrelation ``rho`` are worth,
+    n (1 − ρ)/(1 + ρ) (an AR(1) series' variance of the mean; Bartlett 1946)."""
+    return n * (1.0 - rho) / (1.0 + rho)
+
+
 def _pairs(measured: ArrayLike, simulated: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     y = np.asarray(measured, dtype=float)
     y_hat = np.asarray(simulated, dtype=float)

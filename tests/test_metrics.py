@@ -5,7 +5,15 @@ import warnings
 import numpy as np
 import pytest
 
-from rcengine.metrics import cv_rmse, evaluate, mbe, nmbe, rmse
+from rcengine.metrics import (
+    cv_rmse,
+    effective_count,
+    evaluate,
+    lag1_autocorrelation,
+    mbe,
+    nmbe,
+    rmse,
+)
 
 
 def test_values_by_hand():
@@ -40,3 +48,17 @@ def test_rmse_of_an_absurd_prediction_is_finite_and_exact():
         value = rmse([20.0, 21.0], [7e304, 20.0])
     assert np.isfinite(value)
     assert value == pytest.approx(7e304 / np.sqrt(2.0), rel=1e-12)
+
+
+def test_an_ar1_series_is_worth_fewer_independent_values():
+    """x_t = 0.8 x_{t−1} + e_t: its lag-1 autocorrelation reads 0.8, and 10 000 values are worth
+    10 000 × 0.2 / 1.8 ≈ 1 111 independent ones; NaNs are skipped, a constant series reads 0."""
+    rng = np.random.default_rng(3)
+    x = np.zeros(10_000)
+    for t in range(1, x.size):
+        x[t] = 0.8 * x[t - 1] + rng.normal()
+    x[::97] = np.nan
+    rho = lag1_autocorrelation(x)
+    assert rho == pytest.approx(0.8, abs=0.02)
+    assert effective_count(10_000, 0.8) == pytest.approx(1111.1, abs=0.1)
+    assert lag1_autocorrelation(np.ones(50)) == 0.0

@@ -15,7 +15,7 @@ from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
 from rcengine.estimation.presets import EstimatorSettings
 from rcengine.kalman import kalman_filter
-from rcengine.metrics import rmse
+from rcengine.metrics import effective_count, lag1_autocorrelation, rmse
 from rcengine.network import CompiledNetwork, RCNetwork
 from rcengine.parallel import can_start_processes, process_pool
 from rcengine.signals import SignalOptions, prepare
@@ -90,9 +90,9 @@ class Fit:
         """Effective number of independent training errors, n (1 − ρ₁)/(1 + ρ₁) with ρ₁ the
         lag-1 autocorrelation: simulation residuals are strongly autocorrelated, and counting
         every row would let an information criterion reward any extra parameter."""
-        r = self.residual_train[np.isfinite(self.residual_train)]
-        rho = float(np.corrcoef(r[:-1], r[1:])[0, 1]) if r.size > 2 and r.std() > 0 else 0.0
-        return max(10.0, r.size * (1.0 - rho) / (1.0 + rho)) if rho < 1 else 10.0
+        rho = lag1_autocorrelation(self.residual_train)
+        n = int(np.isfinite(self.residual_train).sum())
+        return max(10.0, effective_count(n, rho)) if rho < 1 else 10.0
 
     def information_criteria(self, n_eff: float) -> dict[str, float]:
         """AIC and BIC of the training fit for ``n_eff`` independent errors; compare two models

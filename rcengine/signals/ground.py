@@ -23,6 +23,8 @@ import numpy as np
 import pandas as pd
 from scipy.signal import lfilter
 
+from rcengine.metrics import effective_count, lag1_autocorrelation
+
 GROUND_TAU_DAYS = 30.0
 # Annual period. [s]
 YEAR_S = 365.2425 * 86400.0
@@ -147,11 +149,9 @@ def annual_mean_uncertainty(
     k = design.shape[1]
     if n <= k + 1:
         return float("inf")
-    rho = float(np.corrcoef(residual[:-1], residual[1:])[0, 1]) if residual.std() > 0 else 0.0
-    rho = min(max(rho, 0.0), 0.99)
-    n_eff = n * (1.0 - rho) / (1.0 + rho)
+    rho = min(max(lag1_autocorrelation(residual), 0.0), 0.99)
     variance = float(residual @ residual) / (n - k)
-    covariance = variance * np.linalg.inv(design.T @ design) * n / n_eff
+    covariance = variance * np.linalg.inv(design.T @ design) * n / effective_count(n, rho)
     return float(np.sqrt(covariance[0, 0]))
 
 
