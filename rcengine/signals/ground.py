@@ -135,20 +135,19 @@ def annual_mean_uncertainty(
     means about the cycle gives the error of the least-squares mean, σ²·[(XᵀX)⁻¹]₀₀ with X the
     design [1, −cos(2π(t − t_cold)/year)] (only [1] when the cycle is flat), counting weather
     spells, not days: n(1 − ρ₁)/(1 + ρ₁) independent days for a lag-1 autocorrelation ρ₁ of the
-    daily scatter (synoptic systems last several days). Returns ``inf`` for fewer than three
-    days: such a record says nothing of the year.
+    daily scatter (synoptic systems last several days). Returns ``inf`` when the days are too
+    few to leave a scatter to read (no more than the fitted values plus one): such a record says
+    nothing of the year.
     """
     series = pd.Series(np.asarray(t_out, dtype=float), index=times).dropna()
     daily = series.resample("1D").mean().dropna()
     n = len(daily)
-    if n < 3:
-        return float("inf")
     shape = np.cos(cycle.phase(daily.index + pd.Timedelta(hours=12)))
-    residual = daily.to_numpy() - (cycle.mean - cycle.amplitude * shape)
     design = np.column_stack([np.ones(n), -shape]) if cycle.amplitude > 0 else np.ones((n, 1))
     k = design.shape[1]
     if n <= k + 1:
         return float("inf")
+    residual = daily.to_numpy() - (cycle.mean - cycle.amplitude * shape)
     rho = min(max(lag1_autocorrelation(residual), 0.0), 0.99)
     variance = float(residual @ residual) / (n - k)
     covariance = variance * np.linalg.inv(design.T @ design) * n / effective_count(n, rho)
