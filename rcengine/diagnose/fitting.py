@@ -92,7 +92,7 @@ class Fit:
         every row would let an information criterion reward any extra parameter."""
         rho = lag1_autocorrelation(self.residual_train)
         n = int(np.isfinite(self.residual_train).sum())
-        return max(10.0, effective_count(n, rho)) if rho < 1 else 10.0
+        return max(10.0, effective_count(n, rho))
 
     def information_criteria(self, n_eff: float) -> dict[str, float]:
         """AIC and BIC of the training fit for ``n_eff`` independent errors; compare two models
