@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from rcengine.building import Building
-from rcengine.columns import T_GROUND, UNIT
+from rcengine.columns import SOLAR_OPAQUE, T_GROUND, UNIT, solar_orientation_signal
 from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
 from rcengine.diagnose.declared import with_declared_glazing
@@ -117,8 +117,8 @@ CASES = {
     ),
     "opaque_solar_gains": Case(
         lambda e: dict.fromkeys(e.new_parameters, 0.3),
-        lambda e: {**dict.fromkeys(e.new_parameters, 0.3), "au_opaque_180_90": 7.0},
-        "solar absorptance × U-value of the south opaque surfaces: 7 W/(m²K) exceeds any opaque "
+        lambda e: {**dict.fromkeys(e.new_parameters, 0.3), "au_opaque_walls": 7.0},
+        "solar absorptance × U-value of the opaque walls: 7 W/(m²K) exceeds any opaque "
         "surface (α ≤ 0.95, U ≤ 6 W/(m²K))",
     ),
     "wind_infiltration": Case(
@@ -281,8 +281,24 @@ def test_opaque_sun_reaches_the_air_as_alpha_r_se_u(gain_context):
     assert ext.detail["node_share"] == pytest.approx(steady_share(net, TRUTH_BASIC, node))
     assert 0.0 < ext.detail["node_share"] < 1.0
     reading = assess(ext, {**TRUTH_BASIC, **dict.fromkeys(ext.new_parameters, 0.3)})
-    for key in ext.detail["orientations"]:
-        assert reading.magnitudes[f"au_{key}"]["value"] == pytest.approx(0.3)
+    for part in ("walls", "roof"):
+        assert reading.magnitudes[f"au_{part}"]["value"] == pytest.approx(0.3)
+
+
+def test_opaque_sun_is_one_construction_per_envelope_part(gain_context):
+    """The facades share one α·U, the roof another: each orientation's irradiance is a heat input
+    scaled by its part's product, so a fit cannot put the sun on one facade and none on the
+    next, as one envelope's walls cannot."""
+    ext = CANDIDATES["opaque_solar_gains"](gain_context)
+    assert set(ext.new_parameters) == {"au_opaque_walls", "au_opaque_roof"}
+    parts = {k: o["parameter"] for k, o in ext.detail["orientations"].items()}
+    assert {p for k, p in parts.items() if ext.detail["orientations"][k]["facade"] == "roof"} == {
+        "au_opaque_roof"
+    }
+    assert len({k for k, p in parts.items() if p == "au_opaque_walls"}) >= 2
+    heat = {h.signal: h.gain for h in ext.network.heat_inputs}
+    for key, parameter in parts.items():
+        assert heat[solar_orientation_signal(SOLAR_OPAQUE, key)] == parameter
 
 
 def test_opaque_sun_cannot_come_from_walls_conducting_more_than_the_building(gain_context):
@@ -291,10 +307,8 @@ def test_opaque_sun_cannot_come_from_walls_conducting_more_than_the_building(gai
     ext = CANDIDATES["opaque_solar_gains"](gain_context)
     dark = assess(ext, {**TRUTH_BASIC, **dict.fromkeys(ext.new_parameters, 5.0)})
     assert any(p.startswith("conductance of the opaque surfaces") for p in dark.problems)
-    areas = {k: o["area_m2"] for k, o in ext.detail["orientations"].items()}
-    smallest = min(areas, key=areas.get)
-    one = {**dict.fromkeys(ext.new_parameters, 0.0), f"au_opaque_{smallest}": 1.0}
-    assert assess(ext, {**TRUTH_BASIC, **one}).plausible
+    roof_only = {**dict.fromkeys(ext.new_parameters, 0.0), "au_opaque_roof": 0.5}
+    assert assess(ext, {**TRUTH_BASIC, **roof_only}).plausible
 
 
 def test_sky_loss_reads_as_the_u_value_of_the_sky_viewing_envelope(gain_context):

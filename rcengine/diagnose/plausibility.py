@@ -184,36 +184,40 @@ def _window(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 
 def _opaque(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Per orientation the fitted α·U (steady share reaching the air over R_se, ISO 13790 Eq. 44),
-    at most that of the darkest surface on the poorest wall; and the conductance those facades
-    must have, Σ A_k·(α·U)_k / α_max (each at least as dark as the darkest paint allows), which
-    cannot exceed the whole fitted envelope's UA: a facade cannot let in the sun of a wall that
-    conducts more heat than the building loses."""
+    """Per envelope part (walls, roof) the fitted α·U (steady share reaching the air over R_se,
+    ISO 13790 Eq. 44), at most that of the darkest surface on the poorest wall; and the
+    conductance those surfaces must have, Σ A_k·(α·U) / α_max (each at least as dark as the
+    darkest paint allows), which cannot exceed the whole fitted envelope's UA: a facade cannot
+    let in the sun of a wall that conducts more heat than the building loses."""
     orientations = ext.detail["orientations"]
-    au = {k: params[f"au_opaque_{k}"] for k in orientations}
+    au = {o["parameter"]: params[o["parameter"]] for o in orientations.values()}
     complete = _readable_steady(ext, params)
     if complete:
         apertures = solar_apertures(ext.network, dict(params))
-        au = {k: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] / R_SE for k in au}
+        au = {
+            o["parameter"]: apertures[solar_orientation_signal(SOLAR_OPAQUE, k)] / R_SE
+            for k, o in orientations.items()
+        }
     most = ABSORPTANCE[1] * U_OPAQUE[1]
+    parts = {name: name.removeprefix("au_opaque_") for name in au}
     readings = [
         Reading(
-            f"au_{k}",
+            f"au_{parts[name]}",
             value,
             "W/(m²K)",
-            f"solar absorptance × U-value of the {orientations[k]['facade']} opaque surfaces",
+            f"solar absorptance × U-value of the opaque {parts[name]}",
             (0.0, most),
             f"opaque surface (α ≤ {ABSORPTANCE[1]:g}, U ≤ {U_OPAQUE[1]:g} W/(m²K))",
         )
-        for k, value in au.items()
+        for name, value in au.items()
     ]
     if complete:
-        implied = sum(au[k] * o["area_m2"] for k, o in orientations.items()) / ABSORPTANCE[1]
+        implied = sum(au[o["parameter"]] * o["area_m2"] for o in orientations.values())
         loss = ua(ext.network, dict(params))
         readings.append(
             Reading(
                 "ua_sunlit",
-                implied,
+                implied / ABSORPTANCE[1],
                 "W/K",
                 "conductance of the opaque surfaces their sun implies, Σ A·(α·U)/α_max",
                 (0.0, loss),
