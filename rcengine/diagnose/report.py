@@ -24,7 +24,8 @@ from rcengine.io.jsonable import jsonable
 MISSING = {
     "window_solar_gains": "solar heat entering through the glazing, which depends on each façade's "
     "orientation and the sun's position",
-    "opaque_solar_gains": "solar heat absorbed by the opaque walls and roof, by orientation",
+    "opaque_solar_gains": "solar heat absorbed by the opaque walls and roof, each facade by the "
+    "sun on its own orientation",
     "wind_infiltration": "air leakage that grows with wind speed",
     "ventilation_schedule": "outdoor-air ventilation during scheduled hours",
     "ground_coupling": "heat exchange through the floor with the slowly varying ground",
