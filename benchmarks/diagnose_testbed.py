@@ -5,7 +5,7 @@
 
 The cases of ``data/testbed/`` (made by ``scripts/make_testbed.py``; ``manifest.json`` says what
 each conceals, ``split.json`` which half it belongs to) — or of a further set,
-``data/testbed_fresh/``, ``data/testbed_sealed/`` or ``data/testbed_sealed_2/``, each held out
+``data/testbed_fresh/`` or one of the sealed sets (``data/testbed_sealed*/``), each held out
 whole — are diagnosed ``--jobs`` at a time (default: every core, one worker process each) with
 the model the manifest names. A case is correct when the first accepted finding is its concealed
 effect; with two concealed effects, when both are accepted and the first accepted is one of them;

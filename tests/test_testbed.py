@@ -29,6 +29,8 @@ from scripts.energyplus.testbed import (
     FRESH_CASES,
     SEALED_2_CASES,
     SEALED_2_SEED,
+    SEALED_3_CASES,
+    SEALED_3_SEED,
     SEALED_CASES,
     SEALED_SEED,
     SETS,
@@ -174,6 +176,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
         ("testbed_fresh", FRESH_CASES, "medium"),
         ("testbed_sealed", SEALED_CASES, "drawn"),
         ("testbed_sealed_2", SEALED_2_CASES, "drawn"),
+        ("testbed_sealed_3", SEALED_3_CASES, "drawn"),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -205,10 +208,14 @@ def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[d
 
 
 def test_the_sealed_sets_are_their_seeds_draws() -> None:
-    """Drawn, not chosen: the committed cases are the seeds', and the two seeds draw others."""
+    """Drawn, not chosen: the committed cases are the seeds', and each seed draws others."""
     assert sealed_cases(SEALED_SEED) == SEALED_CASES
     assert sealed_cases(SEALED_2_SEED) == SEALED_2_CASES
-    assert [c.name for c in SEALED_2_CASES] != [c.name for c in SEALED_CASES]
+    assert sealed_cases(SEALED_3_SEED) == SEALED_3_CASES
+    names = [
+        tuple(c.name for c in cases) for cases in (SEALED_CASES, SEALED_2_CASES, SEALED_3_CASES)
+    ]
+    assert len(set(names)) == 3
 
 
 # --- generator building blocks ----------------------------------------------------------------
