@@ -150,7 +150,7 @@ class ParameterSet:
                 network=network,
                 values=values,
                 building=Building.from_dict(data["building"]),
-                signals=SignalOptions(**data.get("signals", {})),
+                signals=SignalOptions.from_stored(data.get("signals", {})),
                 fit=data.get("fit", {}),
                 metrics=data.get("metrics", {}),
                 engine_version=data.get("engine_version", "unknown"),

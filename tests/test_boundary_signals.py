@@ -20,7 +20,7 @@ from rcengine.signals.schedules import (
     schedule_signal,
     weekly_profile,
 )
-from rcengine.signals.sky import cloud_cover_from_index, sky_temperature
+from rcengine.signals.sky import cloud_cover_from_index, dew_point_estimate, sky_temperature
 
 
 def test_hour_of_week_is_local_time():
@@ -126,12 +126,50 @@ def test_ground_temperature_is_a_slow_running_mean():
 
 
 def test_sky_temperature_by_hand():
+    # Clark & Allen at a dew point of 0 °C: ε = 0.787 + 0.764 ln(273.15 / 273) = 0.7874
+    t_sky = sky_temperature(np.array([5.0]), np.array([0.0]), np.array([0.0]))[0]
+    assert t_sky == pytest.approx(0.7874**0.25 * 278.15 - 273.15, abs=0.05)
+    drier = sky_temperature(np.array([5.0]), np.array([0.0]), np.array([-10.0]))[0]
+    overcast = sky_temperature(np.array([5.0]), np.array([10.0]), np.array([0.0]))[0]
+    assert drier < t_sky < overcast < 5.0  # dry air and clear skies are cold; clouds warm
     # Swinbank at 0 °C: ε = 9.365e-6 · 273.15² = 0.6987; T_sky = ε^¼ · T
-    t_sky = sky_temperature(np.array([0.0]), np.array([0.0]))[0]
-    assert t_sky == pytest.approx(0.6987**0.25 * 273.15 - 273.15, abs=0.05)
-    overcast = sky_temperature(np.array([0.0]), np.array([10.0]))[0]
-    assert t_sky < overcast < 0.0  # clouds warm the sky, still below the air
+    swinbank = sky_temperature(np.array([0.0]), np.array([0.0]), model="swinbank")[0]
+    assert swinbank == pytest.approx(0.6987**0.25 * 273.15 - 273.15, abs=0.05)
     np.testing.assert_allclose(cloud_cover_from_index(np.array([1.0, 0.25, 0.0])), [0, 10, 10])
+    with pytest.raises(ValueError, match="needs the dew point"):
+        sky_temperature(np.array([0.0]), np.array([0.0]))
+
+
+def test_the_dew_point_is_the_lowest_temperature_of_the_day_around():
+    times = pd.date_range("2017-01-01", periods=72, freq="h", tz="UTC")
+    t_out = pd.Series(5.0 + 5.0 * np.sin(2 * np.pi * np.arange(72) / 24), index=times)
+    t_dew = dew_point_estimate(t_out)
+    assert np.all(t_dew <= t_out.to_numpy())
+    np.testing.assert_allclose(t_dew[12:-12], 0.0, atol=1e-9)
+
+
+def test_stored_options_without_a_sky_model_keep_swinbank():
+    """A parameter set stored before the dew point was estimated was fitted to Swinbank's sky;
+    new options and stored ones that name their model keep what they say."""
+    assert SignalOptions().sky_emissivity == "clark_allen"
+    assert SignalOptions.from_stored({"sky_model": "perez"}).sky_emissivity == "swinbank"
+    stored = SignalOptions(sky_emissivity="clark_allen").to_dict()
+    assert SignalOptions.from_stored(stored) == SignalOptions()
+
+
+def test_the_dew_point_sky_follows_the_weather_files_infrared(shared_data):
+    """Against the sky the EPW's infrared field records (EnergyPlus's), over each heating season
+    of the project's weather files: the dew-point estimate tracks it better than Swinbank's and
+    is less biased (``benchmarks/sky_temperature.py``)."""
+    from benchmarks.sky_temperature import ESTIMATE, compare, weather_files
+
+    files = [f for f in weather_files() if f.exists()]
+    assert files
+    for path in files:
+        figures = compare(path)
+        new, old = figures[ESTIMATE]["all"], figures["swinbank"]["all"]
+        assert new["r2"] > old["r2"], (path.name, new, old)
+        assert abs(new["bias_k"]) < abs(old["bias_k"]), (path.name, new, old)
 
 
 def test_each_deriver_runs_once_for_all_its_signals(project_data, monkeypatch):

@@ -256,7 +256,7 @@ def _signal_options(data: dict[str, Any]) -> SignalOptions:
             f"the model's signal settings {unknown} are unknown to this engine "
             f"(version {__version__}); upgrade rcengine"
         )
-    return SignalOptions(**data)
+    return SignalOptions.from_stored(data)
 
 
 def check_columns(spec_or_inputs: ModelSpec | Collection[str], columns: Collection[str]) -> None:

@@ -49,7 +49,10 @@ class SignalOptions:
     "standard" (standard time all year) for playing them back; ground_cycle: the outdoor annual
     cycle under ``t_ground`` (``AnnualCycle.to_dict``), fixed once fitted, else fitted to the
     frame at hand (``signals.ground``); input_hold: "zoh" (the contract's rows, means over their
-    step) or "foh" (inputs recorded as samples, linear in between), ``Dataset.hold``.
+    step) or "foh" (inputs recorded as samples, linear in between), ``Dataset.hold``;
+    sky_emissivity: the clear sky's emissivity model of ``sky_delta`` (``signals.sky``:
+    "clark_allen" or "swinbank", which parameter sets stored before it existed keep,
+    ``from_stored``).
     """
 
     sky_model: str = "isotropic"
@@ -60,6 +63,13 @@ class SignalOptions:
     schedule_clock: str = "local"
     ground_cycle: dict[str, float | str] | None = None
     input_hold: str = "zoh"
+    sky_emissivity: str = "clark_allen"
+
+    @classmethod
+    def from_stored(cls, data: dict) -> SignalOptions:
+        """The options of a stored document. One written before ``sky_emissivity`` existed was
+        fitted to Swinbank's sky, and keeps it so its model forecasts as it was fitted."""
+        return cls(**{"sky_emissivity": "swinbank", **data})
 
     def schedule_zone(self, building: Building) -> Zone:
         return clock_zone(building.location.timezone, self.schedule_clock)
@@ -162,11 +172,13 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
 
 def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
-    from rcengine.signals.sky import daily_cloud_cover, sky_temperature
+    from rcengine.signals.sky import daily_cloud_cover, dew_point_estimate, sky_temperature
 
-    t_out = frame[T_OUT].to_numpy(dtype=float)
+    t_out = frame[T_OUT].astype(float)
     cover = daily_cloud_cover(frame, building.location)
-    return pd.DataFrame({SKY_DELTA: sky_temperature(t_out, cover) - t_out}, index=frame.index)
+    t_dew = dew_point_estimate(t_out)
+    t_sky = sky_temperature(t_out.to_numpy(), cover, t_dew, options.sky_emissivity)
+    return pd.DataFrame({SKY_DELTA: t_sky - t_out.to_numpy()}, index=frame.index)
 
 
 def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
