@@ -31,6 +31,7 @@ from scripts.energyplus.testbed import (
     SEALED_2_SEED,
     SEALED_3_CASES,
     SEALED_3_SEED,
+    SEALED_4_CASES,
     SEALED_CASES,
     SEALED_SEED,
     SETS,
@@ -177,6 +178,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
         ("testbed_sealed", SEALED_CASES, "drawn"),
         ("testbed_sealed_2", SEALED_2_CASES, "drawn"),
         ("testbed_sealed_3", SEALED_3_CASES, "drawn"),
+        ("testbed_sealed_4", SEALED_4_CASES, "drawn"),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
