@@ -477,8 +477,9 @@ SEALED_3_SEED = SEALED_SEED + 3
 SEALED_3_CASES = sealed_cases(SEALED_3_SEED)
 # The fourth, drawn when the third was diagnosed, for the next change to be judged on. The draw
 # of SEALED_SEED + 4 put the window of a sky + window pair at 0.27 K rms of t_in, under the
-# floor: skipped like + 2.
-SEALED_4_SEED = SEALED_SEED + 5
+# floor; that of + 5 put 10 W/m² of unmetered gains in the heavy archetype in San Francisco,
+# which then never heats (q_hvac 0 all season, 29 °C inside): both skipped like + 2.
+SEALED_4_SEED = SEALED_SEED + 6
 SEALED_4_CASES = sealed_cases(SEALED_4_SEED)
 
 
