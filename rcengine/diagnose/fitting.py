@@ -222,18 +222,23 @@ class FitJob:
 def trust_region(
     network: RCNetwork, params: dict[str, float], factor: float = TRUST_FACTOR
 ) -> dict[str, tuple[float, float]]:
-    """Bounds within ``factor`` of ``params`` (a ratio for positive parameters, ``1/factor`` of
-    the range either side for the others), inside the network's own.
+    """Bounds within ``factor`` of ``params`` (a ratio for non-negative parameters, ``1/factor``
+    of the range either side for those that may be negative), inside the network's own.
 
     A few weeks of data identify a grey-box model's parameters poorly: refitted freely, a fold's
     capacities and resistances drift to values that extrapolate its two test weeks by kelvins,
     and one such fold decides the pooled test whatever the candidate does. Near the fit on the
     whole training half, a fold adapts the model to its weeks without leaving that fit's basin.
+    Gains and apertures (non-negative, often fitted at or near zero) keep the same ratio: a third
+    of their whole search range either side let a month of October trade the sun on the walls
+    (an absorption area from 0 to 10 m²) against a doubled sky loss on the project's sky
+    variant, which then missed November by 1.8 K. A gain the training half fitted at zero stays
+    at zero in the folds, which ask whether that fit helps across the season.
     """
     out = {}
     for name, p in network.parameters.items():
         value = min(max(params[name], p.lower), p.upper)
-        if p.lower > 0:
+        if p.lower >= 0:
             out[name] = (max(p.lower, value / factor), min(p.upper, value * factor))
         else:
             half = (p.upper - p.lower) / factor
