@@ -32,6 +32,9 @@ from scripts.energyplus.testbed import (
     SEALED_3_CASES,
     SEALED_3_SEED,
     SEALED_4_CASES,
+    SEALED_4_SEED,
+    SEALED_5_CASES,
+    SEALED_5_SEED,
     SEALED_CASES,
     SEALED_SEED,
     SETS,
@@ -179,6 +182,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
         ("testbed_sealed_2", SEALED_2_CASES, "drawn"),
         ("testbed_sealed_3", SEALED_3_CASES, "drawn"),
         ("testbed_sealed_4", SEALED_4_CASES, "drawn"),
+        ("testbed_sealed_5", SEALED_5_CASES, "drawn"),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -211,13 +215,16 @@ def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[d
 
 def test_the_sealed_sets_are_their_seeds_draws() -> None:
     """Drawn, not chosen: the committed cases are the seeds', and each seed draws others."""
-    assert sealed_cases(SEALED_SEED) == SEALED_CASES
-    assert sealed_cases(SEALED_2_SEED) == SEALED_2_CASES
-    assert sealed_cases(SEALED_3_SEED) == SEALED_3_CASES
-    names = [
-        tuple(c.name for c in cases) for cases in (SEALED_CASES, SEALED_2_CASES, SEALED_3_CASES)
-    ]
-    assert len(set(names)) == 3
+    drawn = {
+        SEALED_SEED: SEALED_CASES,
+        SEALED_2_SEED: SEALED_2_CASES,
+        SEALED_3_SEED: SEALED_3_CASES,
+        SEALED_4_SEED: SEALED_4_CASES,
+        SEALED_5_SEED: SEALED_5_CASES,
+    }
+    for seed, cases in drawn.items():
+        assert sealed_cases(seed) == cases
+    assert len({tuple(c.name for c in cases) for cases in drawn.values()}) == len(drawn)
 
 
 # --- generator building blocks ----------------------------------------------------------------
