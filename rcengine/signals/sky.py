@@ -75,9 +75,8 @@ def sky_temperature(
 
 def dew_point_estimate(t_out: pd.Series) -> np.ndarray:
     """Dew point where humidity is not measured: the lowest air temperature of the
-    ``DEW_POINT_WINDOW`` centred on each row, never above the air's own (FAO-56 Eq. 48). [°C]"""
-    lowest = t_out.rolling(DEW_POINT_WINDOW, center=True, min_periods=1).min()
-    return np.minimum(lowest.to_numpy(dtype=float), t_out.to_numpy(dtype=float))
+    ``DEW_POINT_WINDOW`` centred on each row (so never above the row's own; FAO-56 Eq. 48). [°C]"""
+    return t_out.rolling(DEW_POINT_WINDOW, center=True, min_periods=1).min().to_numpy(dtype=float)
 
 
 def daily_cloud_cover(frame: pd.DataFrame, location: Location) -> np.ndarray:
