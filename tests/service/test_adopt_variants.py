@@ -17,8 +17,8 @@ in milder weather). Diagnosed on October–January, these three are rejected.
 
 Two cases are expected to fail (``KNOWN``): on the record before their test week the diagnosis
 confirms neither window solar gains (−12 %, 0.059 K on its test half) nor sky radiation (−13 %,
-0.082 K with the dew-point sky), short of the 0.1 K margin; the full-season diagnosis (docs/diagnosis.md), which has
-seen the test weeks, finds both.
+0.082 K with the dew-point sky), short of the 0.1 K margin; the full-season diagnosis
+(docs/diagnosis.md), which has seen the test weeks, finds both.
 
 The diagnosis here is a single split with one baseline search (``engine_settings`` patched): what
 is tested is what adoption does with a diagnosis, not how thoroughly the diagnosis looks
