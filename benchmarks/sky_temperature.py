@@ -39,8 +39,8 @@ from rcengine.columns import T_OUT  # noqa: E402
 from rcengine.io.epw import _hour_ends_utc, read_epw  # noqa: E402
 from rcengine.signals.sky import (  # noqa: E402
     KELVIN,
-    daily_cloud_cover,
     dew_point_estimate,
+    sky_delta,
     sky_temperature,
 )
 from rcengine.signals.solar import clear_sky_ghi  # noqa: E402
@@ -79,11 +79,10 @@ def compare(path: Path) -> dict[str, dict[str, dict[str, float]]]:
     frame, location = read_epw(path)
     record = recorded(path, frame.index)
     t_out = frame[T_OUT].to_numpy(float)
-    cover = daily_cloud_cover(frame, location)
     t_dew = dew_point_estimate(frame[T_OUT].astype(float))
     estimates = {
-        ESTIMATE: sky_temperature(t_out, cover, t_dew) - t_out,
-        "swinbank": sky_temperature(t_out, cover, model="swinbank") - t_out,
+        ESTIMATE: sky_delta(frame, location),
+        "swinbank": sky_delta(frame, location, "swinbank"),
         "file's cover": sky_temperature(t_out, record["cover"].to_numpy(), t_dew) - t_out,
     }
     truth = record["t_sky"].to_numpy() - t_out

@@ -172,13 +172,10 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
 
 def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
-    from rcengine.signals.sky import daily_cloud_cover, dew_point_estimate, sky_temperature
+    from rcengine.signals.sky import sky_delta
 
-    t_out = frame[T_OUT].astype(float)
-    cover = daily_cloud_cover(frame, building.location)
-    t_dew = dew_point_estimate(t_out)
-    t_sky = sky_temperature(t_out.to_numpy(), cover, t_dew, options.sky_emissivity)
-    return pd.DataFrame({SKY_DELTA: t_sky - t_out.to_numpy()}, index=frame.index)
+    delta = sky_delta(frame, building.location, options.sky_emissivity)
+    return pd.DataFrame({SKY_DELTA: delta}, index=frame.index)
 
 
 def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:

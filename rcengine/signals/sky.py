@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from rcengine.building import Location
+from rcengine.columns import T_OUT
 
 KELVIN = 273.15
 SWINBANK = 9.365e-6  # [1/K²]
@@ -77,6 +78,16 @@ def dew_point_estimate(t_out: pd.Series) -> np.ndarray:
     """Dew point where humidity is not measured: the lowest air temperature of the
     ``DEW_POINT_WINDOW`` centred on each row (so never above the row's own; FAO-56 Eq. 48). [°C]"""
     return t_out.rolling(DEW_POINT_WINDOW, center=True, min_periods=1).min().to_numpy(dtype=float)
+
+
+def sky_delta(frame: pd.DataFrame, location: Location, model: str = "clark_allen") -> np.ndarray:
+    """T_sky − t_out from the contract columns alone: the cloud cover read from each day's
+    clear-sky index (``daily_cloud_cover``), the dew point from the day's lowest air temperature
+    (``dew_point_estimate``), the clear sky's emissivity by ``model``. [K]"""
+    t_out = frame[T_OUT].astype(float)
+    cover = daily_cloud_cover(frame, location)
+    t_sky = sky_temperature(t_out.to_numpy(), cover, dew_point_estimate(t_out), model)
+    return t_sky - t_out.to_numpy()
 
 
 def daily_cloud_cover(frame: pd.DataFrame, location: Location) -> np.ndarray:
