@@ -671,10 +671,9 @@ def sky_radiation(ctx: Context) -> Extension | Skipped:
     ``SKY_H_R_TYPICAL`` (the lumped wall's conductance is the envelope's average, not the roof's:
     an uninsulated roof over insulated walls). ``sky_delta`` enters the envelope node, scaled
     by R_se over the share of that node's heat that warms the room under the current fit
-    (``steady_share``). The base model has an ordinary insulated envelope's sky loss already
-    (``declared.with_ordinary_sky``): the candidate is the loss beyond it."""
+    (``steady_share``)."""
     effect = "sky_radiation"
-    if "u_sky" in ctx.network.parameters:
+    if SKY_DELTA in ctx.network.signals:
         return Skipped(effect, "the model already has sky radiation")
     target = envelope_node(ctx.network)
     view = sky_view_area(ctx.building)

@@ -11,36 +11,18 @@ beyond it (``candidates.window_solar_gains``).
 The declared glazing enters as ISO 52016-1 and ISO 13790 §11.3 put it: the transmitted sun is
 absorbed by the interior surfaces (the mass node) with a share heating the air directly, and the
 glazing is a massless conductance from the air to outdoors (U_w·A_w) when the model has none.
-
-Every envelope also loses heat to the sky: its outer surfaces see a sky colder than the air, and
-U·R_se·ε·h_r·A·(T_sky − t_out) of that reaches the room in the steady state (the long-wave part
-of the sol-air temperature, ISO 13790 §11.3.5). An ordinary insulated envelope's share is given
-to the base model at fixed U-values (``with_ordinary_sky``), so the sky candidate looks for the
-loss of an envelope worse than that — an uninsulated roof — and not for the loss every building
-has: on the test bed's null cases, which have ordinary envelopes, this loss is 0.5–1.2 K rms of
-the indoor temperature, and left to the candidates it passed for sky radiation, window sun or a
-learnt gain.
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from rcengine.building import Building
-from rcengine.columns import SKY_DELTA, SOLAR_WINDOW, T_OUT
-from rcengine.diagnose.candidates import sky_view_area
-from rcengine.diagnose.plausibility import SKY_H_R_TYPICAL
-from rcengine.models.bounds import G_GLAZING_MAX, R_SE, RHO_CP_AIR, U_GLAZING
+from rcengine.columns import SOLAR_WINDOW, T_OUT
+from rcengine.models.bounds import G_GLAZING_MAX, RHO_CP_AIR, U_GLAZING
 from rcengine.network import Parameter, RCNetwork
 
 # Steady air leakage the glazing conductance may also carry where the model has no other direct
 # path from the air to outdoors: a leaky building's infiltration (EN 12831-1 Table B.5). [1/h]
 LEAKAGE_ACH = 1.0
-# U-values of an ordinary insulated envelope, whose sky loss the base model is given: opaque walls
-# and roofs at 0.35 W/(m²K) and double glazing at 2.0, between current European requirements
-# (walls 0.2–0.4, windows 1.1–1.8) and the insulated stock of recent decades. [W/(m²K)]
-U_ORDINARY_OPAQUE = 0.35
-U_ORDINARY_GLAZING = 2.0
 
 
 def glazing_area(building: Building) -> float:
@@ -98,25 +80,4 @@ def with_declared_glazing(network: RCNetwork, building: Building, mass: str) -> 
             )
         )
         net.add_resistor(T_OUT, air, "r_window", factor=1.0 / area)
-    return net
-
-
-def ordinary_sky_conductance(building: Building) -> float:
-    """R_se·ε·h_r·Σ U·A_view of an ordinary insulated envelope: the heat [W] its sky loss takes
-    from the room per kelvin of T_sky − t_out, with the sky-viewing areas A·(1 + cos β)/2 of the
-    opaque surfaces (``sky_view_area``) and of the windows. [W/K]"""
-    glazing = sum(w.area * (1.0 + np.cos(np.radians(w.tilt))) / 2.0 for w in building.windows)
-    opaque = sky_view_area(building)
-    return R_SE * SKY_H_R_TYPICAL * (U_ORDINARY_OPAQUE * opaque + U_ORDINARY_GLAZING * glazing)
-
-
-def with_ordinary_sky(network: RCNetwork, building: Building) -> RCNetwork:
-    """``network`` with the sky loss of an ordinary insulated envelope
-    (``ordinary_sky_conductance`` × sky_delta into the indoor air, no parameter; a copy, or the
-    network itself when it has a sky input already or the description declares no envelope
-    surfaces: without ``walls`` the sky-viewing area would be a guess)."""
-    if SKY_DELTA in network.signals or not building.walls:
-        return network
-    net = network.copy(network.name)
-    net.add_heat_input(SKY_DELTA, net.output, 1.0, factor=ordinary_sky_conductance(building))
     return net

@@ -303,13 +303,12 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """The sky-viewing envelope's U-value at ε·h_r = ``SKY_H_R_TYPICAL`` (the steady share
-    reached, read from the fitted network: the ordinary envelope's loss the base model has,
-    ``declared.with_ordinary_sky``, and the candidate's), at most the poorest wall's at the
-    highest coupling.
+    reached, read from the fitted network), at most the poorest wall's at the highest coupling.
 
     Unlike the opaque sun's, it is not held against the fitted UA: the sky temperature it is
-    driven by (estimated from the dew point and a cloud cover from the daily clear-sky index) is
-    itself uncertain by tens of percent, which the fitted U absorbs."""
+    driven by (Swinbank, with a cloud cover from the daily clear-sky index) is itself uncertain
+    by tens of percent, which the fitted U absorbs (the project's sky variant, a 0.89 W/(m²K)
+    roof, fits 1.4)."""
     area = ext.detail["sky_view_area_m2"]
     u_sky = params["u_sky"]
     if _readable_steady(ext, params):

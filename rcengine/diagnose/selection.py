@@ -31,7 +31,7 @@ import pandas as pd
 from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
-from rcengine.diagnose.declared import with_declared_glazing, with_ordinary_sky
+from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -75,13 +75,6 @@ from rcengine.signals import SignalOptions
 # candidate (a season's first fold, free-floating until the heating starts, is the usual case).
 # Such a fold — mean |q_hvac| in training below this share of the test window's — is left out. [-]
 MIN_HVAC_SHARE = 0.1
-
-
-# The sun on the facades as EnergyPlus and ISO 52010-1 take it: Perez's anisotropic sky
-# (circumsolar and horizon brightening) and ground reflection at an albedo of 0.2. The thesis's
-# isotropic sky without reflection (Eq. 16–18) misses both, most on the sunny facades in spring:
-# on the test bed's null cases the window candidate then "found" their ordinary glazing's sun.
-DIAGNOSIS_SIGNALS = SignalOptions(sky_model="perez", albedo=0.2)
 
 
 @dataclass(frozen=True)
@@ -224,7 +217,7 @@ def _baseline(problem: Problem, model: str) -> Fit:
     runs in the narrower box of the thesis's typical per-area values (Table 2.3), and a refit
     within the building's bounds started from its optimum competes with the others.
     """
-    settings, options = problem.settings, DIAGNOSIS_SIGNALS
+    settings, options = problem.settings, SignalOptions()
     network = _base_model(problem, model, settings.bounds)
     split = problem.split(network, options)
     starts = [
@@ -248,8 +241,7 @@ def _baseline(problem: Problem, model: str) -> Fit:
 def _base_model(problem: Problem, model: str, bounds: str) -> RCNetwork:
     """The model as given, with the glazing the building declares (``declared``)."""
     network = get_model(model, problem.building, problem.frame.columns, bounds=bounds)
-    declared = with_declared_glazing(network, problem.building, mass_node(network))
-    return with_ordinary_sky(declared, problem.building)
+    return with_declared_glazing(network, problem.building, mass_node(network))
 
 
 def _health(problem: Problem, fit: Fit) -> tuple[FitQuality, Health]:
