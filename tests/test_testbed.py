@@ -35,6 +35,8 @@ from scripts.energyplus.testbed import (
     SEALED_4_SEED,
     SEALED_5_CASES,
     SEALED_5_SEED,
+    SEALED_6_CASES,
+    SEALED_6_SEED,
     SEALED_CASES,
     SEALED_SEED,
     SETS,
@@ -183,6 +185,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
         ("testbed_sealed_3", SEALED_3_CASES, "drawn"),
         ("testbed_sealed_4", SEALED_4_CASES, "drawn"),
         ("testbed_sealed_5", SEALED_5_CASES, "drawn"),
+        ("testbed_sealed_6", SEALED_6_CASES, "drawn"),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -221,6 +224,7 @@ def test_the_sealed_sets_are_their_seeds_draws() -> None:
         SEALED_3_SEED: SEALED_3_CASES,
         SEALED_4_SEED: SEALED_4_CASES,
         SEALED_5_SEED: SEALED_5_CASES,
+        SEALED_6_SEED: SEALED_6_CASES,
     }
     for seed, cases in drawn.items():
         assert sealed_cases(seed) == cases
