@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `scripts` importable
 
 from rcengine.columns import T_OUT  # noqa: E402
-from rcengine.io.epw import _hour_ends_utc, read_epw  # noqa: E402
+from rcengine.io.epw import hour_ends_utc, read_epw  # noqa: E402
 from rcengine.signals.sky import (  # noqa: E402
     KELVIN,
     dew_point_estimate,
@@ -60,7 +60,7 @@ def recorded(path: Path, index: pd.DatetimeIndex) -> pd.DataFrame:
     """The file's sky temperature [°C] and opaque sky cover [tenths] on the contract rows (the
     row of EPW hour h starts at h − 1, as ``read_epw`` stamps the irradiance)."""
     data, meta = pvlib_read_epw(path, coerce_year=2017)
-    starts = _hour_ends_utc(data, meta["TZ"]) - pd.Timedelta(hours=1)
+    starts = hour_ends_utc(data, meta["TZ"]) - pd.Timedelta(hours=1)
     t_sky = (data["ghi_infrared"].to_numpy(float) / STEFAN_BOLTZMANN) ** 0.25 - KELVIN
     cover = data["opaque_sky_cover"].to_numpy(float)
     return pd.DataFrame({"t_sky": t_sky, "cover": cover}, index=starts).reindex(index)

@@ -296,22 +296,21 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
     net = ctx.network.copy(_name(ctx.network, effect))
     groups = {k: (_facade(k), a) for k, a in _areas_by_orientation(ctx.building.walls).items()}
     upper = SEARCH_MARGIN * ABSORPTANCE[1] * U_OPAQUE[1]
-    params, inputs, parameter_of = [], [], {}
+    params, inputs, part_of = [], [], {}
     for key, (facade, _) in groups.items():
         part = "roof" if facade == "roof" else "walls"
         name = f"au_opaque_{part}"
+        part_of[key] = {"part": part, "parameter": name}
         meaning = f"solar absorptance × U-value of the opaque {part}"
         if name not in params:
             net.add_parameter(Parameter(name, "W/(m²K)", 0.0, upper, meaning))
             params.append(name)
         signal = solar_orientation_signal(SOLAR_OPAQUE, key)
         net.add_heat_input(signal, node, name, factor=R_SE / share)
-        parameter_of[key] = name
         inputs.append((signal, node))
     detail = {
         "orientations": {
-            k: {"area_m2": a, "facade": f, "parameter": parameter_of[k]}
-            for k, (f, a) in groups.items()
+            k: {"area_m2": a, "facade": f, **part_of[k]} for k, (f, a) in groups.items()
         },
         "node": node,
         "node_share": share,

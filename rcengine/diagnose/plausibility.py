@@ -199,7 +199,7 @@ def _opaque(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             for k, o in orientations.items()
         }
     most = ABSORPTANCE[1] * U_OPAQUE[1]
-    parts = {name: name.removeprefix("au_opaque_") for name in au}
+    parts = {o["parameter"]: o["part"] for o in orientations.values()}
     readings = [
         Reading(
             f"au_{parts[name]}",

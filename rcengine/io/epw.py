@@ -75,11 +75,11 @@ def read_epw(
     data, meta = pvlib_read_epw(path, coerce_year=year)
     hourly = pd.DataFrame({name: data[field].to_numpy(float) for name, field in EPW_FIELDS.items()})
     _check_ranges(hourly)
-    hour_ends = _hour_ends_utc(data, meta["TZ"])
+    hour_ends = hour_ends_utc(data, meta["TZ"])
     return _resample(hourly, hour_ends, step_s), _location(meta)
 
 
-def _hour_ends_utc(data: pd.DataFrame, tz_offset_h: float) -> pd.DatetimeIndex:
+def hour_ends_utc(data: pd.DataFrame, tz_offset_h: float) -> pd.DatetimeIndex:
     """UTC instants of the EPW stamps (end of each hour), from the file's own date fields."""
     days = pd.to_datetime(data[["year", "month", "day"]].astype(int))
     local = days + pd.to_timedelta(data["hour"].astype(int), unit="h")
