@@ -27,18 +27,8 @@ from scripts.energyplus.archetypes import ARCHETYPES
 from scripts.energyplus.testbed import (
     CASES,
     FRESH_CASES,
-    SEALED_2_CASES,
-    SEALED_2_SEED,
-    SEALED_3_CASES,
-    SEALED_3_SEED,
-    SEALED_4_CASES,
-    SEALED_4_SEED,
-    SEALED_5_CASES,
-    SEALED_5_SEED,
-    SEALED_6_CASES,
-    SEALED_6_SEED,
-    SEALED_CASES,
-    SEALED_SEED,
+    SEALED_SEEDS,
+    SEALED_SETS,
     SETS,
     draw_split,
     sealed_cases,
@@ -180,12 +170,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
     ("name", "cases", "magnitude"),
     [
         ("testbed_fresh", FRESH_CASES, "medium"),
-        ("testbed_sealed", SEALED_CASES, "drawn"),
-        ("testbed_sealed_2", SEALED_2_CASES, "drawn"),
-        ("testbed_sealed_3", SEALED_3_CASES, "drawn"),
-        ("testbed_sealed_4", SEALED_4_CASES, "drawn"),
-        ("testbed_sealed_5", SEALED_5_CASES, "drawn"),
-        ("testbed_sealed_6", SEALED_6_CASES, "drawn"),
+        *((name, cases, "drawn") for name, cases in SEALED_SETS.items()),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -218,17 +203,18 @@ def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[d
 
 def test_the_sealed_sets_are_their_seeds_draws() -> None:
     """Drawn, not chosen: the committed cases are the seeds', and each seed draws others."""
-    drawn = {
-        SEALED_SEED: SEALED_CASES,
-        SEALED_2_SEED: SEALED_2_CASES,
-        SEALED_3_SEED: SEALED_3_CASES,
-        SEALED_4_SEED: SEALED_4_CASES,
-        SEALED_5_SEED: SEALED_5_CASES,
-        SEALED_6_SEED: SEALED_6_CASES,
-    }
-    for seed, cases in drawn.items():
-        assert sealed_cases(seed) == cases
-    assert len({tuple(c.name for c in cases) for cases in drawn.values()}) == len(drawn)
+    assert (
+        list(SEALED_SETS)
+        == list(SEALED_SEEDS)
+        == [
+            "testbed_sealed",
+            *(f"testbed_sealed_{n}" for n in range(2, len(SEALED_SEEDS) + 1)),
+        ]
+    )
+    for name, seed in SEALED_SEEDS.items():
+        assert sealed_cases(seed) == SEALED_SETS[name]
+    names = {tuple(c.name for c in cases) for cases in SEALED_SETS.values()}
+    assert len(names) == len(SEALED_SETS)
 
 
 # --- generator building blocks ----------------------------------------------------------------

@@ -24,9 +24,9 @@ well above it.
 
 ``draw_split`` assigns the cases to a tuning and a held-out half by a seeded draw, stratified so
 that each half has null, one-effect and two-effect cases and one of each effect's weak/strong
-pair. Further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once),
-``SEALED_CASES`` to ``SEALED_5_CASES`` (each drawn from a seed, diagnosed once) and
-``SEALED_6_CASES`` (drawn from a later seed, not yet diagnosed). Entry point:
+pair. Further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once) and
+``SEALED_SETS`` (each drawn from its seed in ``SEALED_SEEDS``, diagnosed once but the last, which
+is not yet). Entry point:
 ``python scripts/make_testbed.py [--set testbed_fresh|testbed_sealed|testbed_sealed_2|...]``.
 """
 
@@ -466,31 +466,29 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
     return tuple(cases.values())
 
 
-SEALED_CASES = sealed_cases()
-# The next sealed set, drawn once the first was spent: the same draw from the next seed.
-SEALED_2_SEED = SEALED_SEED + 1
-SEALED_2_CASES = sealed_cases(SEALED_2_SEED)
-# The third, drawn once the second was spent. SEALED_SEED + 2 drew a window + sky pair whose
-# window moves t_in by 0.045 K rms, under the bed's floor (``MIN_RMS_K``); that draw was
-# simulated, not committed, and its seed is skipped rather than its case replaced by hand.
-SEALED_3_SEED = SEALED_SEED + 3
-SEALED_3_CASES = sealed_cases(SEALED_3_SEED)
-# The fourth, drawn when the third was diagnosed, for the next change to be judged on. The draw
-# of SEALED_SEED + 4 put the window of a sky + window pair at 0.27 K rms of t_in, under the
-# floor; that of + 5 put 10 W/m² of unmetered gains in the heavy archetype in San Francisco,
-# which then never heats (q_hvac 0 all season, 29 °C inside): both skipped like + 2.
-SEALED_4_SEED = SEALED_SEED + 6
-SEALED_4_CASES = sealed_cases(SEALED_4_SEED)
-# The fifth, drawn when the fourth was diagnosed, for the next change to be judged on. The draw
-# of SEALED_SEED + 7 put the window of a window + ground pair at 0.19 K rms of t_in: skipped.
-SEALED_5_SEED = SEALED_SEED + 8
-SEALED_5_CASES = sealed_cases(SEALED_5_SEED)
-# The sixth, drawn when the fifth was diagnosed, for the next change to be judged on. The draw of
-# SEALED_SEED + 9 put the ventilation of a ventilation + sky pair at 0.29 K rms of t_in; + 10 put
-# unmetered gains in the heavy archetype in San Francisco, which then never heats (as + 5): both
-# skipped.
-SEALED_6_SEED = SEALED_SEED + 11
-SEALED_6_CASES = sealed_cases(SEALED_6_SEED)
+# The sealed sets by folder: each the same draw from its own seed, drawn once the one before was
+# spent. A draw that breaks the set's rules is simulated, not committed, and its seed skipped
+# rather than its case replaced by hand:
+# - SEALED_SEED + 2 drew a window + sky pair whose window moves t_in by 0.045 K rms, under the
+#   bed's floor (``MIN_RMS_K``);
+# - + 4 put the window of a sky + window pair at 0.27 K rms; + 5 put 10 W/m² of unmetered gains
+#   in the heavy archetype in San Francisco, which then never heats (q_hvac 0 all season, 29 °C
+#   inside);
+# - + 7 put the window of a window + ground pair at 0.19 K rms;
+# - + 9 put the ventilation of a ventilation + sky pair at 0.29 K rms; + 10 put unmetered gains
+#   in the heavy archetype in San Francisco, which then never heats (as + 5).
+# The last is undiagnosed, for the next change to be judged on.
+SEALED_SEEDS: dict[str, int] = {
+    "testbed_sealed": SEALED_SEED,
+    "testbed_sealed_2": SEALED_SEED + 1,
+    "testbed_sealed_3": SEALED_SEED + 3,
+    "testbed_sealed_4": SEALED_SEED + 6,
+    "testbed_sealed_5": SEALED_SEED + 8,
+    "testbed_sealed_6": SEALED_SEED + 11,
+}
+SEALED_SETS: dict[str, tuple[Case, ...]] = {
+    name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
+}
 
 
 # --- simulation -------------------------------------------------------------------------------
@@ -813,10 +811,5 @@ def draw_split(manifest: Iterable[Mapping], seed: int = SPLIT_SEED) -> dict:
 SETS: dict[str, tuple[tuple[Case, ...], Callable[[list[dict]], dict]]] = {
     "testbed": (CASES, draw_split),
     "testbed_fresh": (FRESH_CASES, all_held_out),
-    "testbed_sealed": (SEALED_CASES, all_held_out),
-    "testbed_sealed_2": (SEALED_2_CASES, all_held_out),
-    "testbed_sealed_3": (SEALED_3_CASES, all_held_out),
-    "testbed_sealed_4": (SEALED_4_CASES, all_held_out),
-    "testbed_sealed_5": (SEALED_5_CASES, all_held_out),
-    "testbed_sealed_6": (SEALED_6_CASES, all_held_out),
+    **{name: (cases, all_held_out) for name, cases in SEALED_SETS.items()},
 }
