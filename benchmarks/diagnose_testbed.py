@@ -11,7 +11,10 @@ the model the manifest names. A case is correct when the first accepted finding 
 effect; with two concealed effects, when both are accepted and the first accepted is one of them;
 with none, when nothing is accepted (each accepted finding on a null case is a false finding).
 Only the held-out half counts. ``--out`` writes each JSON report, ``confusion.md`` (true effect ×
-first finding) and ``tables.md`` (results per archetype and per climate). Last line: JSON {"cases",
+first finding), ``tables.md`` (results per archetype and per climate) and ``separation.md`` (every
+candidate's first-round test gain, the concealed ones marked: how far the true effect stands from
+what the other candidates gain on the same case); ``--tables-only --out DIR`` writes the tables
+again from the reports already in DIR, diagnosing nothing. Last line: JSON {"cases",
 "heldout_cases", "heldout_correct", "tuning_correct", "null_false_findings",
 "two_effect_both_found", "wall_s_per_case"}.
 """
@@ -126,14 +129,72 @@ def grouped_table(results: Iterable[Result], key: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def first_round_gains(report: dict) -> dict[str, tuple[float, str]]:
+    """Per candidate refitted in the first round: the relative change of the single split's test
+    RMSE [-] and its mark ("accepted", "implausible" or ""). A round that accepted a finding keeps
+    only that one's: the report holds each other candidate's latest verdict, of a later round."""
+    gains = {}
+    for f in report["findings"]:
+        if f["round"] != 1 or f.get("rmse_test_after") is None or f.get("baseline_repair"):
+            continue
+        implausible = "implausible" in f["reason"]
+        mark = "accepted" if f["accepted"] else "implausible" if implausible else ""
+        gains[f["effect"]] = (f["rmse_test_after"] / f["rmse_test_before"] - 1.0, mark)
+    return gains
+
+
+def separation_table(results: Iterable[Result]) -> str:
+    """Markdown: per case, every first-round candidate's test gain (bold: a concealed effect; ✓
+    accepted, ✗ implausible), then the largest plausible gain a candidate took on a null case."""
+    results = list(results)
+    effects = sorted({e for r in results for e in first_round_gains(r.report)})
+    lines = [
+        "| case | half | correct | " + " | ".join(effects) + " |",
+        "|---" * (len(effects) + 3) + "|",
+    ]
+    spurious = []
+    for r in results:
+        gains = first_round_gains(r.report)
+        cells = []
+        for effect in effects:
+            if effect not in gains:
+                cells.append("·")
+                continue
+            gain, mark = gains[effect]
+            text = f"{gain:+.0%}" + {"accepted": " ✓", "implausible": " ✗"}.get(mark, "")
+            cells.append(f"**{text}**" if effect in r.case["effects"] else text)
+            if not r.case["effects"] and mark != "implausible":
+                spurious.append((gain, r.case["case"], effect))
+        verdict = "yes" if r.correct else "NO"
+        lines.append(f"| {r.case['case']} | {r.half} | {verdict} | " + " | ".join(cells) + " |")
+    table = "\n".join(lines) + "\n"
+    if spurious:
+        gain, case, effect = min(spurious)
+        table += f"\nLargest plausible gain on a null case: {gain:+.0%} ({effect}, {case}).\n"
+    return table
+
+
 def write_tables(out: Path, results: Sequence[Result]) -> None:
-    """``confusion.md`` (held-out half, then all cases) and ``tables.md`` in ``out``."""
+    """``confusion.md`` (held-out half, then all cases), ``tables.md`` and ``separation.md`` in
+    ``out``."""
     heldout = [r for r in results if r.half == "heldout"]
     confusion = "## Held-out half\n\n" + confusion_matrix(heldout)
     confusion += "\n## All cases\n\n" + confusion_matrix(results)
     (out / "confusion.md").write_text(confusion)
     tables = grouped_table(results, "archetype") + "\n" + grouped_table(results, "climate")
     (out / "tables.md").write_text(tables)
+    (out / "separation.md").write_text(separation_table(results))
+
+
+def stored_results(out: Path, chosen: Sequence[tuple[dict, str]]) -> list[Result]:
+    """The chosen cases' results from the reports a run wrote to ``out`` (wall time unknown: 0)."""
+    missing = [e["case"] for e, _ in chosen if not (out / f"{e['case']}.json").exists()]
+    if missing:
+        raise SystemExit(f"no report in {out} for: {', '.join(missing)}")
+    return [
+        Result(entry, half, json.loads((out / f"{entry['case']}.json").read_text()), 0.0)
+        for entry, half in chosen
+    ]
 
 
 def case_line(r: Result) -> str:
@@ -171,11 +232,19 @@ def main() -> None:
     parser.add_argument("--half", choices=HALVES, help="only this half of the split")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="cases at a time")
     parser.add_argument("--out", type=Path, help="folder for the reports and tables")
+    parser.add_argument(
+        "--tables-only", action="store_true", help="tables from the reports in --out, no diagnosis"
+    )
     args = parser.parse_args()
+    if args.tables_only and not args.out:
+        parser.error("--tables-only needs --out, the folder of a run's reports")
     folder = ROOT / "data" / args.set
     manifest = json.loads((folder / "manifest.json").read_text())
     split = json.loads((folder / "split.json").read_text())
     chosen = select(manifest, split, args.half, args.cases)
+    if args.tables_only:
+        write_tables(args.out, stored_results(args.out, chosen))
+        return
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
     # Cases side by side, one worker each; a single case gets the diagnosis's own pool.

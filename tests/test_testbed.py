@@ -19,6 +19,7 @@ from benchmarks.diagnose_testbed import (
     grouped_table,
     is_correct,
     select,
+    separation_table,
     summary,
 )
 from rcengine.building import Building
@@ -311,6 +312,40 @@ def test_confusion_matrix_and_tables() -> None:
     assert matrix[3] == "| thermal_mass | · | 1 | 1 |"
     by_climate = grouped_table(results, "climate").splitlines()
     assert by_climate[2:] == ["| chicago | 0/1 | 0/0 | 0/1 |", "| torino | 1/1 | 1/1 | 2/2 |"]
+
+
+def _candidate(effect: str, after: float, accepted: bool = False, reason: str = "", r=1) -> dict:
+    return {
+        "effect": effect,
+        "accepted": accepted,
+        "round": r,
+        "rmse_test_before": 1.0,
+        "rmse_test_after": after,
+        "reason": reason,
+    }
+
+
+def test_separation_table_marks_the_concealed_and_the_nulls_largest_plausible_gain() -> None:
+    null = {
+        "findings": [
+            _candidate("unmetered_gains", 0.8),
+            _candidate("window_solar_gains", 0.7, reason="rejected: implausible: g-value"),
+        ]
+    }
+    found = {
+        "findings": [
+            _candidate("window_solar_gains", 0.4, accepted=True),
+            _candidate("unmetered_gains", 0.9, r=2),  # a later round's: not in the table
+        ]
+    }
+    table = separation_table(
+        [_result([], "heldout", null), _result(["window_solar_gains"], "tuning", found)]
+    ).splitlines()
+    assert table[0] == "| case | half | correct | unmetered_gains | window_solar_gains |"
+    assert table[2] == "| x | heldout | yes | -20% | -30% ✗ |"
+    assert table[3] == "| x | tuning | yes | · | **-60% ✓** |"
+    # The implausible −30 % is not a gain the diagnosis could have taken.
+    assert table[-1] == "Largest plausible gain on a null case: -20% (unmetered_gains, x)."
 
 
 def test_select_takes_the_half_and_the_named_cases(manifest: list[dict], split: dict) -> None:
