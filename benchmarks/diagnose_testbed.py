@@ -244,6 +244,7 @@ def main() -> None:
     chosen = select(manifest, split, args.half, args.cases)
     if args.tables_only:
         write_tables(args.out, stored_results(args.out, chosen))
+        print(f"confusion.md, tables.md and separation.md written from the reports in {args.out}")
         return
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
