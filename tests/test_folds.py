@@ -104,6 +104,21 @@ def test_head_to_head_names_the_winner_and_the_margin():
     assert head_to_head(weak, strong)[0] == 1
 
 
+def test_head_to_head_counts_folds_before_the_pooled_rmse():
+    # Better in five folds of six, worse pooled: one fold's large error carries the pooled RMSE.
+    steady = _evidence([1.0] * 6, [0.5] * 5 + [1.5])
+    lucky = _evidence([1.0] * 6, [0.6] * 5 + [0.4])
+    assert steady.pooled_after > lucky.pooled_after
+    winner, why = head_to_head(lucky, steady)
+    assert winner == 1
+    assert why.startswith("better in 1 of 6 folds; pooled test RMSE")
+    # Equal counts: the lower pooled RMSE wins.
+    even = _evidence([1.0] * 4, [0.5, 0.5, 0.9, 0.9])
+    other = _evidence([1.0] * 4, [0.6, 0.6, 0.8, 0.8])
+    assert other.pooled_after < even.pooled_after
+    assert head_to_head(even, other)[0] == 1
+
+
 def _version(effect: str, schedule: str, sse_train: float, after: float) -> Finding:
     return Finding(
         effect,

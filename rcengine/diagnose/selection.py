@@ -641,8 +641,8 @@ def _without_each(
 def _winner(
     confirmed: list[Finding], verdicts: dict[str, Finding], round_no: int
 ) -> Finding | None:
-    """Of the round's accepted findings, the one that wins every head to head (on the folds'
-    pooled test when they were judged on folds, else on the single split's test); the others
+    """Of the round's accepted findings, the one that wins every head to head (on the folds when
+    they were judged on folds, ``folds.head_to_head``, else on the single split's test); the others
     are marked not taken with why they lost, the closest as the winner's runner-up, and the
     winner leaves ``verdicts`` (it is accepted, not a verdict)."""
     winners = [f for f in confirmed if f.accepted]
