@@ -25,8 +25,7 @@ well above it.
 ``draw_split`` assigns the cases to a tuning and a held-out half by a seeded draw, stratified so
 that each half has null, one-effect and two-effect cases and one of each effect's weak/strong
 pair. Further sets are held out whole: ``FRESH_CASES`` (chosen, diagnosed once) and
-``SEALED_SETS`` (each drawn from its seed in ``SEALED_SEEDS``, diagnosed once but the last, which
-is not yet). Entry point:
+``SEALED_SETS`` (each drawn from its seed in ``SEALED_SEEDS`` and diagnosed once). Entry point:
 ``python scripts/make_testbed.py [--set testbed_fresh|testbed_sealed|testbed_sealed_2|...]``.
 """
 
