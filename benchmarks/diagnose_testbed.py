@@ -147,14 +147,14 @@ def separation_table(results: Iterable[Result]) -> str:
     """Markdown: per case, every first-round candidate's test gain (bold: a concealed effect; ✓
     accepted, ✗ implausible), then the largest plausible gain a candidate took on a null case."""
     results = list(results)
-    effects = sorted({e for r in results for e in first_round_gains(r.report)})
+    gains_of = [first_round_gains(r.report) for r in results]
+    effects = sorted({e for gains in gains_of for e in gains})
     lines = [
         "| case | half | correct | " + " | ".join(effects) + " |",
         "|---" * (len(effects) + 3) + "|",
     ]
     spurious = []
-    for r in results:
-        gains = first_round_gains(r.report)
+    for r, gains in zip(results, gains_of, strict=True):
         cells = []
         for effect in effects:
             if effect not in gains:

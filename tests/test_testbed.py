@@ -314,7 +314,9 @@ def test_confusion_matrix_and_tables() -> None:
     assert by_climate[2:] == ["| chicago | 0/1 | 0/0 | 0/1 |", "| torino | 1/1 | 1/1 | 2/2 |"]
 
 
-def _candidate(effect: str, after: float, accepted: bool = False, reason: str = "", r=1) -> dict:
+def _candidate(
+    effect: str, after: float, accepted: bool = False, reason: str = "", r: int = 1
+) -> dict:
     return {
         "effect": effect,
         "accepted": accepted,
