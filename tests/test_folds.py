@@ -236,9 +236,9 @@ def test_the_backward_check_drops_the_least_worth_first_and_checks_again(monkeyp
 
 
 def test_a_fold_refit_stays_near_the_fit_on_the_training_half():
-    """Non-negative parameters (gains searched from zero too) within a factor, the others within
-    a share of their range either side, always inside the network's own bounds; a gain fitted
-    at zero stays there."""
+    """Every parameter within a factor of its fit with its sign kept (gains searched from zero
+    and the soil's heat, which may be negative, too), always inside the network's own bounds; a
+    gain fitted at zero stays there."""
     net = RCNetwork("chain")
     net.add_parameter(Parameter("r_env", "K/W", 1e-3, 1.0, "envelope"))
     net.add_parameter(Parameter("c_air", "J/K", 1e5, 1e8, "air"))
@@ -246,15 +246,19 @@ def test_a_fold_refit_stays_near_the_fit_on_the_training_half():
     net.add_parameter(Parameter("alpha_wall", "m²", 0.0, 60.0, "aperture"))
     net.add_parameter(Parameter("u_sky", "W/(m²K)", 0.0, 10.0, "sky"))
     fitted = {"r_env": 0.5, "c_air": 2e5, "q_ground": 50.0, "alpha_wall": 0.0, "u_sky": 1.5}
-    region = trust_region(net, fitted, factor=4.0)
-    assert region["r_env"] == pytest.approx((0.125, 1.0))  # clipped at the upper bound
-    assert region["c_air"] == pytest.approx((1e5, 8e5))  # clipped at the lower bound
-    assert region["q_ground"] == pytest.approx((30.0, 60.0))  # ± 80/4 W/m², clipped
-    assert region["alpha_wall"] == (0.0, 0.0)
-    assert region["u_sky"] == pytest.approx((0.375, 6.0))
-    for name, (low, high) in region.items():
-        p = net.parameters[name]
-        assert p.lower <= low <= high <= p.upper
+    for q_ground, expected in ((50.0, (12.5, 60.0)), (-8.0, (-20.0, -2.0))):
+        region = trust_region(net, {**fitted, "q_ground": q_ground}, factor=4.0)
+        assert region["r_env"] == pytest.approx((0.125, 1.0))  # clipped at the upper bound
+        assert region["c_air"] == pytest.approx((1e5, 8e5))  # clipped at the lower bound
+        assert region["q_ground"] == pytest.approx(expected)  # the sign kept, clipped
+        assert region["alpha_wall"] == (0.0, 0.0)
+        assert region["u_sky"] == pytest.approx((0.375, 6.0))
+        for name, (low, high) in region.items():
+            p = net.parameters[name]
+            assert p.lower <= low <= high <= p.upper
+    # A tighter factor never widens the region (range / factor either side once did, for q_ground).
+    wide, tight = (trust_region(net, fitted, factor=f)["q_ground"] for f in (3.0, 1.5))
+    assert wide[0] <= tight[0] <= tight[1] <= wide[1]
 
 
 def test_the_test_period_is_simulated_on_from_training_without_its_measurements():

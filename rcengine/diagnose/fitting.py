@@ -224,8 +224,8 @@ class FitJob:
 def trust_region(
     network: RCNetwork, params: dict[str, float], factor: float = TRUST_FACTOR
 ) -> dict[str, tuple[float, float]]:
-    """Bounds within ``factor`` of ``params`` (a ratio for non-negative parameters, ``1/factor``
-    of the range either side for those that may be negative), inside the network's own.
+    """Bounds within ``factor`` of ``params`` — the same sign, the magnitude at most ``factor``
+    larger or smaller — inside the network's own.
 
     A few weeks of data identify a grey-box model's parameters poorly: refitted freely, a fold's
     capacities and resistances drift to values that extrapolate its two test weeks by kelvins,
@@ -235,16 +235,16 @@ def trust_region(
     of their whole search range either side let a month of October trade the sun on the walls
     (an absorption area from 0 to 10 m²) against a doubled sky loss on the project's sky
     variant, which then missed November by 1.8 K. A gain the training half fitted at zero stays
-    at zero in the folds, which ask whether that fit helps across the season.
+    at zero in the folds, which ask whether that fit helps across the season. So does a
+    parameter that may be negative (the soil's constant heat ``q_ground``): it had a share of
+    its range, range / factor either side, which grew as the factor shrank — at 1.5, ±53 W/m²,
+    tens of kelvin of ground temperature — and let a fold re-level the soil at will.
     """
     out = {}
     for name, p in network.parameters.items():
         value = min(max(params[name], p.lower), p.upper)
-        if p.lower >= 0:
-            out[name] = (max(p.lower, value / factor), min(p.upper, value * factor))
-        else:
-            half = (p.upper - p.lower) / factor
-            out[name] = (max(p.lower, value - half), min(p.upper, value + half))
+        low, high = sorted((value / factor, value * factor))
+        out[name] = (max(p.lower, low), min(p.upper, high))
     return out
 
 
