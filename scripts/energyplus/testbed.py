@@ -478,7 +478,7 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 #   in the heavy archetype in San Francisco, which then never heats (as + 5);
 # - + 12 put the window of a window + wind pair at 0.23 K rms; + 13 put the wind of a wind + sky
 #   pair at 0.07 K rms.
-# Each has been diagnosed once; the next change needs a new seed here.
+# Each but the last has been diagnosed once; the next change after it needs a new seed here.
 SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed": SEALED_SEED,
     "testbed_sealed_2": SEALED_SEED + 1,
@@ -487,6 +487,7 @@ SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed_5": SEALED_SEED + 8,
     "testbed_sealed_6": SEALED_SEED + 11,
     "testbed_sealed_7": SEALED_SEED + 14,
+    "testbed_sealed_8": SEALED_SEED + 15,
 }
 SEALED_SETS: dict[str, tuple[Case, ...]] = {
     name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
