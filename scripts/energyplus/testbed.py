@@ -478,7 +478,7 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 #   in the heavy archetype in San Francisco, which then never heats (as + 5);
 # - + 12 put the window of a window + wind pair at 0.23 K rms; + 13 put the wind of a wind + sky
 #   pair at 0.07 K rms.
-# Each but the last has been diagnosed once; the next change after it needs a new seed here.
+# Each has been diagnosed once; the next change needs a new seed here.
 SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed": SEALED_SEED,
     "testbed_sealed_2": SEALED_SEED + 1,
