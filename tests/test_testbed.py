@@ -22,6 +22,7 @@ from benchmarks.diagnose_testbed import (
     separation_table,
     summary,
 )
+from benchmarks.diagnosis_reliability import figures, precision_table, recall_table, results_of
 from rcengine.building import Building
 from rcengine.io.timeseries import read_timeseries
 from scripts.energyplus.archetypes import ARCHETYPES
@@ -385,3 +386,38 @@ def test_first_week_of_a_case_regenerates(testbed: Path) -> None:
     assert np.abs(fresh["t_in"] - committed["t_in"]).max() <= 0.011
     assert np.abs(fresh["q_hvac"] - committed["q_hvac"]).max() <= 1.0
     np.testing.assert_allclose(fresh["t_out"], committed["t_out"], atol=0.006)
+
+
+def test_reliability_counts_recall_per_effect_and_precision_per_first_finding() -> None:
+    results = [
+        _result([], "heldout", _report("unmetered_gains")),
+        _result([], "heldout", _report()),
+        _result(["unmetered_gains"], "heldout", _report("unmetered_gains")),
+        _result(["sky_radiation"], "heldout", _report("wind_infiltration")),
+        _result(["sky_radiation"], "tuning", _report()),
+        _result(["sky_radiation", "wind_infiltration"], "heldout", _report("wind_infiltration")),
+    ]
+    recall = recall_table(results).splitlines()
+    assert recall[2:] == [
+        "| sky_radiation | 2 | 0 | 1 | 1 |",
+        "| unmetered_gains | 1 | 1 | 0 | 0 |",
+    ]
+    precision = precision_table(results).splitlines()
+    # The null's gain and the lone sky case's wind are wrong; the pair's wind is right.
+    assert precision[2:] == ["| unmetered_gains | 2 | 1 |", "| wind_infiltration | 2 | 1 |"]
+    assert figures(results) == {
+        "cases": 6,
+        "single_effect_found": 1,
+        "single_effect_cases": 3,
+        "null_false": 1,
+        "null_cases": 2,
+        "pairs_both_found": 0,
+        "pairs": 1,
+    }
+
+
+def test_reliability_reads_sets_and_says_what_a_source_must_be(tmp_path: Path) -> None:
+    with pytest.raises(SystemExit, match="expected SET=DIR"):
+        results_of(str(tmp_path))
+    with pytest.raises(SystemExit, match="no report in"):
+        results_of(f"testbed={tmp_path}")
