@@ -205,6 +205,13 @@ def case_line(r: Result) -> str:
     )
 
 
+def read_set(name: str) -> tuple[Path, list[dict], dict]:
+    """A test-bed set's folder (``data/<name>``), its manifest and its split."""
+    folder = ROOT / "data" / name
+    manifest = json.loads((folder / "manifest.json").read_text())
+    return folder, manifest, json.loads((folder / "split.json").read_text())
+
+
 def select(manifest: list[dict], split: dict, half: str | None, names: Sequence[str]) -> list:
     """(manifest entry, half) of the cases asked for, in manifest order."""
     half_of = {name: h for h in HALVES for name in split[h]}
@@ -238,9 +245,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.tables_only and not args.out:
         parser.error("--tables-only needs --out, the folder of a run's reports")
-    folder = ROOT / "data" / args.set
-    manifest = json.loads((folder / "manifest.json").read_text())
-    split = json.loads((folder / "split.json").read_text())
+    folder, manifest, split = read_set(args.set)
     chosen = select(manifest, split, args.half, args.cases)
     if args.tables_only:
         write_tables(args.out, stored_results(args.out, chosen))

@@ -28,7 +28,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
-from benchmarks.diagnose_testbed import NONE, Result, select, stored_results  # noqa: E402
+from benchmarks.diagnose_testbed import (  # noqa: E402
+    NONE,
+    Result,
+    read_set,
+    select,
+    stored_results,
+)
 from scripts.energyplus.testbed import SETS  # noqa: E402
 
 
@@ -92,9 +98,7 @@ def results_of(source: str) -> list[Result]:
     name, sep, folder = source.partition("=")
     if not sep or name not in SETS:
         raise SystemExit(f"expected SET=DIR with SET one of {', '.join(SETS)}, got {source!r}")
-    data = ROOT / "data" / name
-    manifest = json.loads((data / "manifest.json").read_text())
-    split = json.loads((data / "split.json").read_text())
+    _, manifest, split = read_set(name)
     return stored_results(Path(folder), select(manifest, split, None, ()))
 
 
