@@ -478,6 +478,9 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 #   in the heavy archetype in San Francisco, which then never heats (as + 5);
 # - + 12 put the window of a window + wind pair at 0.23 K rms; + 13 put the wind of a wind + sky
 #   pair at 0.07 K rms.
+# The ninth (+ 16) was committed as drawn: its heavy San Francisco null heats 19 kWh all season
+# and its heavy San Francisco ground + window pair 98 kWh, each still heated at some time, the
+# rule every set was drawn under.
 # Each has been diagnosed once; the next change needs a new seed here.
 SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed": SEALED_SEED,
@@ -488,6 +491,7 @@ SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed_6": SEALED_SEED + 11,
     "testbed_sealed_7": SEALED_SEED + 14,
     "testbed_sealed_8": SEALED_SEED + 15,
+    "testbed_sealed_9": SEALED_SEED + 16,
 }
 SEALED_SETS: dict[str, tuple[Case, ...]] = {
     name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
