@@ -27,12 +27,18 @@ def diagnose_folder(
     out: Path | None = None,
     figures: bool = True,
     settings: DiagnoseSettings | None = None,
+    cloud_from: Path | None = None,
 ) -> tuple[dict, float]:
     """Diagnose the case in ``folder`` with ``model``: its report as JSON data and the wall time
-    of the diagnosis [s]. With ``out``, ``<case>.json`` (and its figures) are written there."""
+    of the diagnosis [s]. With ``out``, ``<case>.json`` (and its figures) are written there;
+    with ``cloud_from``, the weather file's cloud cover is added as the ``cloud_cover`` column."""
     name = folder.name
     building = Building.from_json(folder / "building.json")
     frame = read_timeseries(folder / "data.csv")
+    if cloud_from is not None:
+        from benchmarks.sky_temperature import weather_cloud_cover
+
+        frame = frame.assign(cloud_cover=weather_cloud_cover(cloud_from, frame.index))
     started = time.perf_counter()
     report = diagnose(frame, building, model, settings)
     wall = time.perf_counter() - started

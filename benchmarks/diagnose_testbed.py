@@ -1,7 +1,7 @@
 """Mismatch diagnosis over the test bed of buildings it was never tuned on (issue 11).
 
     python benchmarks/diagnose_testbed.py [--set testbed|testbed_fresh|testbed_sealed|...]
-        [--half tuning|heldout] [--jobs N] [--out DIR] [CASE ...]
+        [--half tuning|heldout] [--jobs N] [--out DIR] [--cloud-from-weather] [CASE ...]
 
 The cases of ``data/testbed/`` (made by ``scripts/make_testbed.py``; ``manifest.json`` says what
 each conceals, ``split.json`` which half it belongs to) — or of a further set,
@@ -14,7 +14,9 @@ Only the held-out half counts. ``--out`` writes each JSON report, ``confusion.md
 first finding), ``tables.md`` (results per archetype and per climate) and ``separation.md`` (every
 candidate's first-round test gain, the concealed ones marked: how far the true effect stands from
 what the other candidates gain on the same case); ``--tables-only --out DIR`` writes the tables
-again from the reports already in DIR, diagnosing nothing. Last line: JSON {"cases",
+again from the reports already in DIR, diagnosing nothing. ``--cloud-from-weather`` adds each
+case's weather-file cloud cover as the optional ``cloud_cover`` column, as data from a weather
+service with cloud cover would have it (the committed CSVs have none). Last line: JSON {"cases",
 "heldout_cases", "heldout_correct", "tuning_correct", "null_false_findings",
 "two_effect_both_found", "wall_s_per_case"}.
 """
@@ -36,7 +38,7 @@ sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
 from benchmarks._cases import accepted_effects, diagnose_folder  # noqa: E402
 from rcengine.diagnose import DiagnoseSettings  # noqa: E402
-from scripts.energyplus.testbed import SETS  # noqa: E402
+from scripts.energyplus.testbed import CLIMATES, SETS  # noqa: E402
 
 HALVES = ("tuning", "heldout")
 NONE = "none"
@@ -226,10 +228,11 @@ def select(manifest: list[dict], split: dict, half: str | None, names: Sequence[
 
 
 def _diagnose(
-    folder: Path, entry: dict, out: Path | None, workers: int | None
+    folder: Path, entry: dict, out: Path | None, workers: int | None, cloud: bool
 ) -> tuple[dict, float]:
     settings = None if workers is None else DiagnoseSettings(workers=workers)
-    return diagnose_folder(folder / entry["case"], entry["model"], out, False, settings)
+    weather = CLIMATES[entry["climate"]].epw if cloud else None
+    return diagnose_folder(folder / entry["case"], entry["model"], out, False, settings, weather)
 
 
 def main() -> None:
@@ -241,6 +244,11 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="folder for the reports and tables")
     parser.add_argument(
         "--tables-only", action="store_true", help="tables from the reports in --out, no diagnosis"
+    )
+    parser.add_argument(
+        "--cloud-from-weather",
+        action="store_true",
+        help="add each case's weather-file cloud cover as the optional cloud_cover column",
     )
     args = parser.parse_args()
     if args.tables_only and not args.out:
@@ -258,7 +266,10 @@ def main() -> None:
     started = time.perf_counter()
     results = []
     with ProcessPoolExecutor(args.jobs) as pool:
-        runs = [pool.submit(_diagnose, folder, entry, args.out, workers) for entry, _ in chosen]
+        runs = [
+            pool.submit(_diagnose, folder, entry, args.out, workers, args.cloud_from_weather)
+            for entry, _ in chosen
+        ]
         for (entry, half), run in zip(chosen, runs, strict=True):
             results.append(Result(entry, half, *run.result()))
             print(case_line(results[-1]), flush=True)

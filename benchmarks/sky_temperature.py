@@ -15,7 +15,8 @@ of the record on the estimate (below 1: the estimate swings more than the record
 least-squares fit of its gain answers by shrinking it) and the mean bias [K]. Measured beside it
 in the same run: Swinbank's emissivity from the air temperature alone (the engine's estimate
 before, ``sky_emissivity="swinbank"``), and the dew-point estimate fed the file's own opaque sky
-cover — the gap to it is what the cloud-cover estimate costs.
+cover as the contract's optional ``cloud_cover`` column (``SignalOptions.cloud_cover="column"``)
+— the gap to it is what the cloud-cover estimate costs, and what data with a cloud column gain.
 
     python benchmarks/sky_temperature.py
 
@@ -35,21 +36,22 @@ from pvlib.iotools import read_epw as pvlib_read_epw
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `scripts` importable
 
-from rcengine.columns import T_OUT  # noqa: E402
+from rcengine.columns import CLOUD_COVER, T_OUT  # noqa: E402
 from rcengine.io.epw import hour_ends_utc, read_epw  # noqa: E402
 from rcengine.signals.sky import (  # noqa: E402
     KELVIN,
-    dew_point_estimate,
     sky_delta,
-    sky_temperature,
 )
 from rcengine.signals.solar import clear_sky_ghi  # noqa: E402
 from scripts.energyplus.testbed import WEATHER, tmy3  # noqa: E402
 
 STEFAN_BOLTZMANN = 5.670374419e-8  # [W/(m²K⁴)]
 HEATING_MONTHS = (10, 11, 12, 1, 2, 3)
+# The calendar year a typical-year file's rows are read into.
+TYPICAL_YEAR = 2017
 ESTIMATE = "dew point"
-ESTIMATES = (ESTIMATE, "swinbank", "file's cover")
+COLUMN = "cloud column"
+ESTIMATES = (ESTIMATE, "swinbank", COLUMN)
 
 
 def weather_files() -> list[Path]:
@@ -59,11 +61,22 @@ def weather_files() -> list[Path]:
 def recorded(path: Path, index: pd.DatetimeIndex) -> pd.DataFrame:
     """The file's sky temperature [°C] and opaque sky cover [tenths] on the contract rows (the
     row of EPW hour h starts at h − 1, as ``read_epw`` stamps the irradiance)."""
-    data, meta = pvlib_read_epw(path, coerce_year=2017)
+    data, meta = pvlib_read_epw(path, coerce_year=TYPICAL_YEAR)
     starts = hour_ends_utc(data, meta["TZ"]) - pd.Timedelta(hours=1)
     t_sky = (data["ghi_infrared"].to_numpy(float) / STEFAN_BOLTZMANN) ** 0.25 - KELVIN
     cover = data["opaque_sky_cover"].to_numpy(float)
     return pd.DataFrame({"t_sky": t_sky, "cover": cover}, index=starts).reindex(index)
+
+
+def weather_cloud_cover(path: Path, index: pd.DatetimeIndex) -> pd.Series:
+    """The EPW's opaque sky cover as the contract's ``cloud_cover`` [%] on the rows of
+    ``index`` (UTC; each row takes its hour's value, the typical year's on the same date)."""
+    year = TYPICAL_YEAR
+    typical = recorded(path, pd.date_range(f"{year}-01-01", periods=366 * 24, freq="h", tz="UTC"))
+    hours = index.floor("h")
+    same_date = pd.DatetimeIndex([t.replace(year=year) for t in hours])
+    cover = typical["cover"].reindex(same_date).to_numpy()
+    return pd.Series(10.0 * cover, index=index, name=CLOUD_COVER)
 
 
 def agreement(estimate: np.ndarray, record: np.ndarray) -> dict[str, float]:
@@ -79,11 +92,12 @@ def compare(path: Path) -> dict[str, dict[str, dict[str, float]]]:
     frame, location = read_epw(path)
     record = recorded(path, frame.index)
     t_out = frame[T_OUT].to_numpy(float)
-    t_dew = dew_point_estimate(frame[T_OUT].astype(float))
+    # The file's opaque sky cover [tenths] as a weather service's cloud cover [%].
+    clouded = frame.assign(**{CLOUD_COVER: 10.0 * record["cover"]})
     estimates = {
         ESTIMATE: sky_delta(frame, location),
         "swinbank": sky_delta(frame, location, "swinbank"),
-        "file's cover": sky_temperature(t_out, record["cover"].to_numpy(), t_dew) - t_out,
+        COLUMN: sky_delta(clouded, location, cloud="column"),
     }
     truth = record["t_sky"].to_numpy() - t_out
     season = frame.index.month.isin(HEATING_MONTHS) & np.isfinite(truth)

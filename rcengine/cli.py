@@ -168,7 +168,11 @@ def _model_to_fit(
     signal settings, its sky model included)."""
     if model_file is None:
         assert model is not None
-        return model, get_model(model, building, frame.columns), SignalOptions(sky_model=sky)
+        return (
+            model,
+            get_model(model, building, frame.columns),
+            SignalOptions.for_columns(frame.columns, sky_model=sky),
+        )
     spec = ModelSpec.load(model_file)
     check_columns(spec, frame.columns)
     return spec.name, spec.network(building), spec.signals

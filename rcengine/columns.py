@@ -17,6 +17,7 @@ DHI = "dhi"
 Q_OCC = "q_occ"
 Q_LIGHT = "q_light"
 WIND_SPEED = "wind_speed"
+CLOUD_COVER = "cloud_cover"
 
 
 @dataclass(frozen=True)
@@ -49,6 +50,7 @@ COLUMNS: dict[str, Column] = {
         Column(Q_OCC, "W", False, "sensible heat from occupants", 0.0, 1e7),
         Column(Q_LIGHT, "W", False, "metered lighting and plug-load heat", 0.0, 1e8),
         Column(WIND_SPEED, "m/s", False, "wind speed at weather-station height", 0.0, 80.0),
+        Column(CLOUD_COVER, "%", False, "share of the sky covered by cloud", 0.0, 100.0),
     )
 }
 

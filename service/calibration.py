@@ -206,7 +206,10 @@ def fit_parameter_set(
     """The engine's GA + GPS fit of ``model``, or of the adopted model ``spec`` (its network
     and derived-signal settings), on the training rows."""
     if spec is None:
-        network, signals = get_model(model, building, training.columns), SignalOptions()
+        network, signals = (
+            get_model(model, building, training.columns),
+            SignalOptions.for_columns(training.columns),
+        )
     else:
         check_columns(spec, training.columns)
         network, signals, model = spec.network(building), spec.signals, spec.name

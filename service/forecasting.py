@@ -220,7 +220,7 @@ class Forecaster:
         loaded = self._loaded(building_id, set_id)
         _require_rows(frame, first, end)
         # Named by the columns to upload, not by the derived inputs computed from them.
-        check_future_columns(frame, loaded.compiled.input_names, start, end)
+        check_future_columns(frame, loaded.compiled.input_names, start, end, loaded.pset.signals)
         result, data = forecast_frame(
             loaded.compiled,
             loaded.pset.values,

@@ -20,7 +20,13 @@ from rcengine.signals.schedules import (
     schedule_signal,
     weekly_profile,
 )
-from rcengine.signals.sky import cloud_cover_from_index, dew_point_estimate, sky_temperature
+from rcengine.signals.sky import (
+    cloud_cover,
+    cloud_cover_from_index,
+    dew_point_estimate,
+    sky_delta,
+    sky_temperature,
+)
 
 
 def test_hour_of_week_is_local_time():
@@ -157,11 +163,42 @@ def test_stored_options_without_a_sky_model_keep_swinbank():
     assert SignalOptions.from_stored(stored) == SignalOptions()
 
 
+def test_a_cloud_cover_column_drives_the_sky_where_it_has_values(project_data):
+    """The data's cloud cover [%] replaces the daylight estimate row by row (rows without one
+    keep the estimate); an overcast sky is warmer than a clear one; the options ask for it when
+    the data have the column, and a model fitted so cannot run on data without it."""
+    office = project_data / "energyplus" / "office"
+    building = Building.from_json(office / "building.json")
+    frame = read_timeseries(office / "heating.csv").iloc[: 3 * 96]
+    location = building.location
+    estimate = cloud_cover(frame, location)
+    clouded = frame.assign(cloud_cover=np.where(np.arange(len(frame)) < 96, 100.0, np.nan))
+    measured = cloud_cover(clouded, location, "column")
+    np.testing.assert_allclose(measured[:96], 10.0)
+    np.testing.assert_allclose(measured[96:], estimate[96:])
+    clear = frame.assign(cloud_cover=0.0)
+    assert np.all(
+        sky_delta(clouded, location, cloud="column")[:96]
+        > sky_delta(clear, location, cloud="column")[:96]
+    )
+    with pytest.raises(ValueError, match="cloud_cover"):
+        cloud_cover(frame, location, "column")
+    with pytest.raises(ValueError, match="unknown cloud cover source"):
+        cloud_cover(frame, location, "satellite")
+    options = SignalOptions.for_columns(clouded.columns)
+    assert options.cloud_cover == "column"
+    assert SignalOptions.for_columns(frame.columns, sky_model="perez") == SignalOptions(
+        sky_model="perez"
+    )
+    with pytest.raises(ModelError, match="needs the column 'cloud_cover'"):
+        derive(frame, building, ["sky_delta"], options)
+
+
 def test_the_dew_point_sky_follows_the_weather_files_infrared(shared_data):
     """Against the sky the EPW's infrared field records (EnergyPlus's), over each heating season
     of the project's weather files: the dew-point estimate tracks it better than Swinbank's and
     is less biased (``benchmarks/sky_temperature.py``)."""
-    from benchmarks.sky_temperature import ESTIMATE, compare, weather_files
+    from benchmarks.sky_temperature import COLUMN, ESTIMATE, compare, weather_files
 
     files = [f for f in weather_files() if f.exists()]
     assert files
@@ -170,6 +207,9 @@ def test_the_dew_point_sky_follows_the_weather_files_infrared(shared_data):
         new, old = figures[ESTIMATE]["all"], figures["swinbank"]["all"]
         assert new["r2"] > old["r2"], (path.name, new, old)
         assert abs(new["bias_k"]) < abs(old["bias_k"]), (path.name, new, old)
+        # The file's own cloud cover as the data's column: the night is no longer a guess.
+        column = figures[COLUMN]["night"]
+        assert column["r2"] > 0.85 > figures[ESTIMATE]["night"]["r2"], (path.name, column)
 
 
 def test_each_deriver_runs_once_for_all_its_signals(project_data, monkeypatch):

@@ -194,6 +194,19 @@ def test_physically_impossible_values():
     assert any("500 °C is outside" in p.message for p in problems)
 
 
+def test_cloud_cover_is_a_percentage():
+    rows = [f"{r},{c}" for r, c in zip(good_rows(3), ["0", "62.5", "100"], strict=True)]
+    assert read_timeseries(csv(*rows, header=HEADER + ",cloud_cover"))["cloud_cover"].tolist() == [
+        0.0,
+        62.5,
+        100.0,
+    ]
+    rows[1] = rows[1].removesuffix("62.5") + "6.25e2"
+    (problem,) = problems_of(csv(*rows, header=HEADER + ",cloud_cover"))
+    assert (problem.row, problem.column) == (1, "cloud_cover")
+    assert "%" in problem.message
+
+
 def test_irradiance_noise_clipped_beyond_noise_rejected():
     rows = [f"{t},20,3,{g},0" for t, g in zip(quarter_hours(3), ["-4.5", "0", "250"], strict=True)]
     assert read_timeseries(csv(*rows))["ghi"].tolist() == [0.0, 0.0, 250.0]

@@ -21,9 +21,15 @@ from rcengine.columns import (
     VENT_SCHEDULE,
     WIND_LOSS,
 )
-from rcengine.exceptions import ModelError
+from rcengine.exceptions import DataValidationError, ModelError
 from rcengine.models import get_model
-from rcengine.models.spec import SPEC_VERSION, ModelSpec, building_key, columns_needed
+from rcengine.models.spec import (
+    SPEC_VERSION,
+    ModelSpec,
+    building_key,
+    check_future_columns,
+    columns_needed,
+)
 from rcengine.network import Parameter
 from rcengine.signals import SignalOptions, prepare
 from rcengine.simulate import simulate
@@ -160,6 +166,13 @@ def test_the_columns_a_model_needs_are_named(frame):
     needed = {"t_out", "ghi", "q_hvac", "q_occ", "q_light", "wind_speed"}
     assert set(spec.required_columns) == needed
     assert columns_needed(["sched_gains", "sky_delta", "solar_window_90_90"]) == ["t_out", "ghi"]
+    measured_sky = SignalOptions(cloud_cover="column")
+    assert columns_needed(["sky_delta"], measured_sky) == ["cloud_cover", "t_out", "ghi"]
+    assert columns_needed(["wind_loss"], measured_sky) == ["t_out", "wind_speed"]
+    start, end = frame.index[10], frame.index[20]
+    check_future_columns(frame, ["sky_delta"], start, end)
+    with pytest.raises(DataValidationError, match="needs 'cloud_cover' over the forecast"):
+        check_future_columns(frame, ["sky_delta"], start, end, measured_sky)
     base = ModelSpec.base(get_model("basic", BUILDING), "basic", BUILDING)
     assert base.name == "basic" and base.effects == () and base.source == {"kind": "base"}
 

@@ -217,7 +217,7 @@ def _baseline(problem: Problem, model: str) -> Fit:
     runs in the narrower box of the thesis's typical per-area values (Table 2.3), and a refit
     within the building's bounds started from its optimum competes with the others.
     """
-    settings, options = problem.settings, SignalOptions()
+    settings, options = problem.settings, SignalOptions.for_columns(problem.frame.columns)
     network = _base_model(problem, model, settings.bounds)
     split = problem.split(network, options)
     starts = [

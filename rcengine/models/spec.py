@@ -27,9 +27,11 @@ import pandas as pd
 from rcengine import __version__
 from rcengine.building import Building
 from rcengine.columns import (
+    CLOUD_COVER,
     DERIVED_FROM,
     GHI,
     NUMERIC_COLUMNS,
+    SKY_DELTA,
     SOLAR_OPAQUE,
     SOLAR_WINDOW,
     T_GROUND,
@@ -56,10 +58,13 @@ def building_key(building: Building) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def columns_needed(inputs: Iterable[str]) -> list[str]:
-    """The contract columns the model inputs ``inputs`` are read or derived from."""
+def columns_needed(inputs: Iterable[str], signals: SignalOptions | None = None) -> list[str]:
+    """The contract columns the model inputs ``inputs`` are read or derived from (with the
+    derived-signal settings ``signals``: a sky read from measured cloud cover needs it)."""
     needed: list[str] = []
     for name in inputs:
+        if name == SKY_DELTA and signals is not None and signals.cloud_cover == "column":
+            needed.append(CLOUD_COVER)
         if name in NUMERIC_COLUMNS:
             needed.append(name)
         elif name in DERIVED_FROM:
@@ -97,7 +102,7 @@ class ModelSpec:
     @property
     def required_columns(self) -> list[str]:
         """Contract columns the data (and a forecast's future rows) must hold."""
-        return columns_needed(self.inputs)
+        return columns_needed(self.inputs, self.signals)
 
     def network(self, building: Building) -> RCNetwork:
         """A fresh copy of the network for ``building``; a different building is an error."""
@@ -261,14 +266,22 @@ def _signal_options(data: dict[str, Any]) -> SignalOptions:
 
 def check_columns(spec_or_inputs: ModelSpec | Collection[str], columns: Collection[str]) -> None:
     """ModelError naming the contract columns the model needs that ``columns`` lack."""
-    inputs = spec_or_inputs.inputs if isinstance(spec_or_inputs, ModelSpec) else spec_or_inputs
-    missing = [c for c in columns_needed(inputs) if c not in columns]
+    needed = (
+        spec_or_inputs.required_columns
+        if isinstance(spec_or_inputs, ModelSpec)
+        else columns_needed(spec_or_inputs)
+    )
+    missing = [c for c in needed if c not in columns]
     if missing:
         raise ModelError(f"the model needs the column(s) {missing}, absent from the data")
 
 
 def check_future_columns(
-    frame: pd.DataFrame, inputs: Collection[str], start: pd.Timestamp, end: pd.Timestamp
+    frame: pd.DataFrame,
+    inputs: Collection[str],
+    start: pd.Timestamp,
+    end: pd.Timestamp,
+    signals: SignalOptions | None = None,
 ) -> None:
     """DataValidationError naming each contract column the model's ``inputs`` are computed from
     that the rows in [start, end) — a forecast's future rows — lack, with how many and the first
@@ -276,7 +289,7 @@ def check_future_columns(
     by their own names, which no upload has."""
     rows = frame.loc[(frame.index >= start) & (frame.index < end)]
     problems = []
-    for column in columns_needed(inputs):
+    for column in columns_needed(inputs, signals):
         values = rows[column] if column in rows.columns else pd.Series(float("nan"), rows.index)
         missing = rows.index[values.isna().to_numpy()]
         if len(missing):

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
 from rcengine.columns import (
+    CLOUD_COVER,
     NUMERIC_COLUMNS,
     SKY_DELTA,
     T_GROUND,
@@ -52,7 +54,9 @@ class SignalOptions:
     step) or "foh" (inputs recorded as samples, linear in between), ``Dataset.hold``;
     sky_emissivity: the clear sky's emissivity model of ``sky_delta`` (``signals.sky``:
     "clark_allen" or "swinbank", which parameter sets stored before it existed keep,
-    ``from_stored``).
+    ``from_stored``); cloud_cover: where ``sky_delta``'s cloud cover comes from, "estimated"
+    (from ``ghi``) or "column" (the data's ``cloud_cover``, which a forecast's future rows then
+    need too; ``for_columns`` chooses it when the fitted data have the column).
     """
 
     sky_model: str = "isotropic"
@@ -64,6 +68,13 @@ class SignalOptions:
     ground_cycle: dict[str, float | str] | None = None
     input_hold: str = "zoh"
     sky_emissivity: str = "clark_allen"
+    cloud_cover: str = "estimated"
+
+    @classmethod
+    def for_columns(cls, columns: Iterable[str], **options: Any) -> SignalOptions:
+        """Options for data with ``columns``: the measured cloud cover where there is one."""
+        cloud = "column" if CLOUD_COVER in columns else "estimated"
+        return cls(**{"cloud_cover": cloud, **options})
 
     @classmethod
     def from_stored(cls, data: dict) -> SignalOptions:
@@ -174,7 +185,9 @@ def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
     from rcengine.signals.sky import sky_delta
 
-    delta = sky_delta(frame, building.location, options.sky_emissivity)
+    if options.cloud_cover == "column":
+        _require(frame, CLOUD_COVER, SKY_DELTA)
+    delta = sky_delta(frame, building.location, options.sky_emissivity, options.cloud_cover)
     return pd.DataFrame({SKY_DELTA: delta}, index=frame.index)
 
 

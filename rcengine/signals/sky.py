@@ -3,8 +3,13 @@
 Clear-sky emissivity from the dew point (Clark & Allen 1978, as EnergyPlus computes it where a
 weather file has no infrared field), raised for cloud cover (Clark & Allen), with the cloud cover
 estimated from how much of the clear-sky irradiance reached the ground during the day (Kasten &
-Czeplak 1980); nights take the cloudiness of the surrounding daylight hours. The contract has no
-humidity column: the dew point is taken as the lowest air temperature of the surrounding 24 h,
+Czeplak 1980); nights take the cloudiness of the surrounding daylight hours. Where the data
+carry the contract's optional ``cloud_cover`` column (a weather service's or station's cloud
+cover, %), that cover is used instead (``sky_delta(..., cloud="column")``): the daylight index
+says nothing of a night, and against the weather files' own infrared field the estimated cover
+leaves R² ≈ 0.5 where the files' recorded cover reaches 0.95 (``benchmarks/sky_temperature.py``).
+The contract has no humidity column: the dew point is taken as the lowest air temperature of the
+surrounding 24 h,
 the approximation FAO-56 (Allen et al. 1998, Eq. 48) makes where humidity is not measured — the
 air cools at night to about its dew point. Swinbank's (1963) emissivity from the air temperature
 alone, which the engine used before, stays available (``SKY_EMISSIVITY``): against the infrared
@@ -18,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from rcengine.building import Location
-from rcengine.columns import T_OUT
+from rcengine.columns import CLOUD_COVER, T_OUT
 
 KELVIN = 273.15
 SWINBANK = 9.365e-6  # [1/K²]
@@ -29,6 +34,9 @@ SKY_EMISSIVITY = ("clark_allen", "swinbank")
 DEW_POINT_WINDOW = "24h"
 # Daylight rows used to judge cloudiness: sun high enough for the clear-sky index to mean much.
 MIN_CLEAR_GHI_W_M2 = 50.0
+# Where the cloud cover comes from: "estimated" from the daylight clear-sky index, or "column",
+# the data's ``cloud_cover`` (rows without it take the estimate).
+CLOUD_SOURCES = ("estimated", "column")
 
 
 def cloud_cover_from_index(clear_sky_index: np.ndarray) -> np.ndarray:
@@ -80,14 +88,33 @@ def dew_point_estimate(t_out: pd.Series) -> np.ndarray:
     return t_out.rolling(DEW_POINT_WINDOW, center=True, min_periods=1).min().to_numpy(dtype=float)
 
 
-def sky_delta(frame: pd.DataFrame, location: Location, model: str = "clark_allen") -> np.ndarray:
-    """T_sky − t_out from the contract columns alone: the cloud cover read from each day's
-    clear-sky index (``daily_cloud_cover``), the dew point from the day's lowest air temperature
-    (``dew_point_estimate``), the clear sky's emissivity by ``model``. [K]"""
+def sky_delta(
+    frame: pd.DataFrame, location: Location, model: str = "clark_allen", cloud: str = "estimated"
+) -> np.ndarray:
+    """T_sky − t_out: the cloud cover by ``cloud`` (``cloud_cover``), the dew point from the
+    day's lowest air temperature (``dew_point_estimate``), the clear sky's emissivity by
+    ``model``. [K]"""
     t_out = frame[T_OUT].astype(float)
-    cover = daily_cloud_cover(frame, location)
+    cover = cloud_cover(frame, location, cloud)
     t_sky = sky_temperature(t_out.to_numpy(), cover, dew_point_estimate(t_out), model)
     return t_sky - t_out.to_numpy()
+
+
+def cloud_cover(frame: pd.DataFrame, location: Location, cloud: str = "estimated") -> np.ndarray:
+    """Cloud cover per row [tenths]: the data's ``cloud_cover`` [%] where ``cloud`` is "column"
+    (``ValueError`` if the frame has none; rows without a value take the estimate), else the
+    estimate from the daylight clear-sky index (``daily_cloud_cover``)."""
+    if cloud not in CLOUD_SOURCES:
+        raise ValueError(f"unknown cloud cover source {cloud!r}; use one of {CLOUD_SOURCES}")
+    estimate = daily_cloud_cover(frame, location)
+    if cloud == "estimated":
+        return estimate
+    if CLOUD_COVER not in frame.columns or not frame[CLOUD_COVER].notna().any():
+        raise ValueError(
+            f"the sky's cloud cover is read from '{CLOUD_COVER}', absent from the data"
+        )
+    measured = frame[CLOUD_COVER].to_numpy(dtype=float) / 10.0
+    return np.where(np.isfinite(measured), measured, estimate)
 
 
 def daily_cloud_cover(frame: pd.DataFrame, location: Location) -> np.ndarray:

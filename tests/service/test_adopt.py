@@ -315,6 +315,16 @@ def test_migration_0004_adds_and_removes_the_adoption_tables(tmp_path):
     db.dispose()
 
 
+def test_migration_0005_adds_and_removes_the_cloud_cover_column(tmp_path):
+    db = Database(f"sqlite:///{tmp_path / 'm.db'}")
+    db.migrate()
+    assert "cloud_cover" in {c["name"] for c in inspect(db.engine).get_columns("measurements")}
+    migrate(db, command.downgrade, "0004")
+    assert "cloud_cover" not in {c["name"] for c in inspect(db.engine).get_columns("measurements")}
+    assert schema_revision(db) == "0004"
+    db.dispose()
+
+
 def test_auto_adopt_adopts_a_diagnosis_with_findings_and_calibrates(tmp_path, truth, monkeypatch):
     settings = app_settings(
         f"sqlite:///{tmp_path / 'auto.db'}", preset="modestpy", training_days=3, auto_adopt=True

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 from datetime import UTC, datetime, timedelta, timezone
 
+import numpy as np
 import pytest
 from alembic import command
 from alembic.autogenerate import compare_metadata
@@ -15,7 +16,7 @@ from sqlalchemy.dialects import postgresql
 from sqlalchemy.exc import IntegrityError, StatementError
 from typer.testing import CliRunner
 
-from service import repository
+from service import bridge, repository
 from service.cli import app as cli
 from service.core.config import Settings
 from service.core.db import Database, alembic_config
@@ -112,6 +113,21 @@ def test_deleting_a_building_deletes_its_rows(client, settings, synthetic):
         session.execute(text("DELETE FROM buildings WHERE id = :id"), {"id": building_id})
     with database.session() as session:
         assert session.execute(text("SELECT count(*) FROM measurements")).scalar() == 0
+    database.dispose()
+
+
+def test_an_uploaded_cloud_cover_is_stored_and_read_back(client, settings, synthetic):
+    """The contract's optional cloud_cover column (%) goes through the upload into storage."""
+    building_id, headers = register(client)
+    rows = synthetic.iloc[:4].assign(cloud_cover=[0.0, 25.0, None, 100.0])
+    response = client.post(
+        f"/buildings/{building_id}/measurements", json={"rows": json_rows(rows)}, headers=headers
+    )
+    assert response.status_code < 300, response.text
+    database = Database(settings.database_url)
+    with database.session() as session:
+        frame = bridge.load_frame(session, building_id)
+    np.testing.assert_array_equal(frame["cloud_cover"].to_numpy(), [0.0, 25.0, np.nan, 100.0])
     database.dispose()
 
 
