@@ -9,6 +9,7 @@ import pytest
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
+from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.health import FitQuality, check_health, fit_quality, same_time_earlier
 from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
@@ -184,6 +185,20 @@ def test_a_zero_aperture_is_a_note_not_a_reason():
     health = check_health(net, {**TRUTH_BASIC, "alpha_int": 0.0}, GOOD, building=b)
     assert health.healthy and health.on_bounds == ("alpha_int",)
     assert health.notes == ("alpha_int ≈ 0 (0 m²): the fit does without it",)
+
+
+def test_glazing_admitting_more_sun_than_glass_is_a_note():
+    """Each share of the declared glazing's g-value within clear glass's 0.87, their sum above
+    it: noted, not counted against the base model; an ordinary sum is not noted."""
+    b = with_surfaces()
+    net = with_declared_glazing(get_model("basic", b, bounds="building"), b, "int")
+    fitted = {**TRUTH_BASIC, "g_window": 0.7, "g_window_air": 0.5, "r_window": 0.5}
+    health = check_health(net, fitted, GOOD)
+    assert health.healthy
+    (note,) = [n for n in health.notes if "glazing" in n]
+    assert note.startswith("the declared glazing admits g = 1.20 of its sun, more than clear")
+    ordinary = check_health(net, {**fitted, "g_window_air": 0.1}, GOOD)
+    assert not [n for n in ordinary.notes if "glazing" in n]
 
 
 def test_a_heat_loss_beyond_the_envelope_is_a_reason():
