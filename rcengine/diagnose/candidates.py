@@ -24,6 +24,7 @@ from rcengine.building import Building
 from rcengine.columns import (
     GAINS_SCHEDULE,
     Q_HVAC,
+    Q_LIGHT,
     Q_OCC,
     SCHED_GAINS,
     SKY_DELTA,
@@ -569,9 +570,20 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
         "unmetered internal heat (equipment, people) in the scheduled hours, per m² of floor",
     )
     heat = (SCHED_GAINS, ctx.network.output)
-    detail = {"floor_area_m2": floor, **occupied_shares(ctx, learnt)}
+    detail = {
+        "floor_area_m2": floor,
+        **occupied_shares(ctx, learnt),
+        **metered_gains_on_schedule(ctx, learnt),
+    }
     ext = _with_gain(ctx, effect, q_unmetered, heat, detail, floor)
     return _on_schedule(ext, GAINS_SCHEDULE, learnt)
+
+
+def _on_learnt_hours(ctx: Context, learnt: LearntSchedule) -> np.ndarray:
+    """The training rows the ``learnt`` schedule is on."""
+    zone = clock_zone(ctx.building.location.timezone, learnt.clock)
+    closed = closed_weekdays(ctx.train, zone)
+    return learnt.schedule[hour_of_week(ctx.data.times, zone, closed)] > 0.0
 
 
 def occupied_shares(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
@@ -581,13 +593,24 @@ def occupied_shares(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
     if Q_OCC not in ctx.train.columns:
         return {}
     occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
-    zone = clock_zone(ctx.building.location.timezone, learnt.clock)
-    closed = closed_weekdays(ctx.train, zone)
-    on = learnt.schedule[hour_of_week(ctx.data.times, zone, closed)] > 0.0
+    on = _on_learnt_hours(ctx, learnt)
     if not occupied.any() or not on.any():
         return {}
     share, share_all = float(occupied[on].mean()), float(occupied.mean())
     return {"occupied_share": share, "occupied_share_all": share_all}
+
+
+def metered_gains_on_schedule(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
+    """The metered internal gains (``q_occ`` + ``q_light``) per m² of floor, averaged over the
+    training rows the ``learnt`` schedule is on (``metered_w_m2``) [W/m²]; empty without either
+    column or when they meter nothing there."""
+    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
+    on = _on_learnt_hours(ctx, learnt)
+    if not columns or not on.any():
+        return {}
+    metered = sum(np.nan_to_num(ctx.train[c].to_numpy(dtype=float)) for c in columns)
+    level = float(np.mean(metered[on])) / ctx.building.floor_area
+    return {"metered_w_m2": level} if level > 0.0 else {}
 
 
 def ground_coupling(ctx: Context) -> Extension | Skipped:
