@@ -570,10 +570,11 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
         "unmetered internal heat (equipment, people) in the scheduled hours, per m² of floor",
     )
     heat = (SCHED_GAINS, ctx.network.output)
+    on = _on_learnt_hours(ctx, learnt)
     detail = {
         "floor_area_m2": floor,
-        **occupied_shares(ctx, learnt),
-        **metered_gains_on_schedule(ctx, learnt),
+        **occupied_shares(ctx, on),
+        **metered_gains_on_schedule(ctx, on),
     }
     ext = _with_gain(ctx, effect, q_unmetered, heat, detail, floor)
     return _on_schedule(ext, GAINS_SCHEDULE, learnt)
@@ -586,26 +587,24 @@ def _on_learnt_hours(ctx: Context, learnt: LearntSchedule) -> np.ndarray:
     return learnt.schedule[hour_of_week(ctx.data.times, zone, closed)] > 0.0
 
 
-def occupied_shares(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
-    """Shares of the training rows in which occupants are metered (``q_occ`` > 0): of those on
-    the ``learnt`` schedule (``occupied_share``) and of all (``occupied_share_all``) [-]; empty
+def occupied_shares(ctx: Context, on: np.ndarray) -> dict[str, float]:
+    """Shares of the training rows in which occupants are metered (``q_occ`` > 0): of those a
+    learnt schedule is ``on`` (``occupied_share``) and of all (``occupied_share_all``) [-]; empty
     without a ``q_occ`` column, or when it meters no occupant."""
     if Q_OCC not in ctx.train.columns:
         return {}
     occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
-    on = _on_learnt_hours(ctx, learnt)
     if not occupied.any() or not on.any():
         return {}
     share, share_all = float(occupied[on].mean()), float(occupied.mean())
     return {"occupied_share": share, "occupied_share_all": share_all}
 
 
-def metered_gains_on_schedule(ctx: Context, learnt: LearntSchedule) -> dict[str, float]:
+def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
     """The metered internal gains (``q_occ`` + ``q_light``) per m² of floor, averaged over the
-    training rows the ``learnt`` schedule is on (``metered_w_m2``) [W/m²]; empty without either
+    training rows a learnt schedule is ``on`` (``metered_w_m2``) [W/m²]; empty without either
     column or when they meter nothing there."""
     columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
-    on = _on_learnt_hours(ctx, learnt)
     if not columns or not on.any():
         return {}
     metered = sum(np.nan_to_num(ctx.train[c].to_numpy(dtype=float)) for c in columns)

@@ -160,9 +160,10 @@ def check_health(
     """
     net = network.compile() if isinstance(network, RCNetwork) else network
     on_bounds, reasons, notes = _bound_findings(net, params, bounds, margin)
-    notes.extend(_glazing_notes(net, params))
+    apertures = solar_apertures(net, dict(params))
+    notes.extend(_glazing_notes(apertures))
     if building is not None:
-        reasons.extend(_envelope_findings(net, params, building))
+        reasons.extend(_envelope_findings(net, params, apertures, building))
     reasons.extend(_fit_findings(net.name, quality, building))
     return Health(tuple(reasons), tuple(on_bounds), tuple(notes))
 
@@ -195,9 +196,9 @@ def _bound_findings(
     return on_bounds, reasons, notes
 
 
-def _glazing_notes(net: CompiledNetwork, params: Mapping[str, float]) -> list[str]:
+def _glazing_notes(apertures: Mapping[str, float]) -> list[str]:
     """The declared glazing's g-value (its steady aperture) above clear glass's."""
-    g = solar_apertures(net, dict(params)).get(SOLAR_WINDOW)
+    g = apertures.get(SOLAR_WINDOW)
     if g is None or g <= G_GLAZING_MAX:
         return []
     return [
@@ -208,12 +209,15 @@ def _glazing_notes(net: CompiledNetwork, params: Mapping[str, float]) -> list[st
 
 
 def _envelope_findings(
-    net: CompiledNetwork, params: Mapping[str, float], building: Building
+    net: CompiledNetwork,
+    params: Mapping[str, float],
+    apertures: Mapping[str, float],
+    building: Building,
 ) -> list[str]:
-    """The fitted UA, and the effective aperture to ghi, against what the building allows."""
+    """The fitted UA, and the effective aperture to ghi (of the fit's ``apertures``), against
+    what the building allows."""
     env = envelope(building)
     checks = [("heat-loss coefficient", ua(net, dict(params)), heat_loss_coefficient(env), "W/K")]
-    apertures = solar_apertures(net, dict(params))
     if GHI in apertures:
         checks.append(("solar aperture", apertures[GHI], (0.0, solar_aperture_max(env)), "m²"))
     reasons = []

@@ -9,12 +9,11 @@ cover, %), that cover is used instead (``sky_delta(..., cloud="column")``): the 
 says nothing of a night, and against the weather files' own infrared field the estimated cover
 leaves R² ≈ 0.5 where the files' recorded cover reaches 0.95 (``benchmarks/sky_temperature.py``).
 The contract has no humidity column: the dew point is taken as the lowest air temperature of the
-surrounding 24 h,
-the approximation FAO-56 (Allen et al. 1998, Eq. 48) makes where humidity is not measured — the
-air cools at night to about its dew point. Swinbank's (1963) emissivity from the air temperature
-alone, which the engine used before, stays available (``SKY_EMISSIVITY``): against the infrared
-field of the project's six weather files it ran 2–6 K colder over the heating season and tracked
-it less well (``benchmarks/sky_temperature.py``).
+surrounding 24 h, the approximation FAO-56 (Allen et al. 1998, Eq. 48) makes where humidity is
+not measured — the air cools at night to about its dew point. Swinbank's (1963) emissivity from
+the air temperature alone, which the engine used before, stays available (``SKY_EMISSIVITY``):
+against the infrared field of the project's six weather files it ran 2–6 K colder over the
+heating season and tracked it less well (``benchmarks/sky_temperature.py``).
 """
 
 from __future__ import annotations
@@ -106,15 +105,16 @@ def cloud_cover(frame: pd.DataFrame, location: Location, cloud: str = "estimated
     estimate from the daylight clear-sky index (``daily_cloud_cover``)."""
     if cloud not in CLOUD_SOURCES:
         raise ValueError(f"unknown cloud cover source {cloud!r}; use one of {CLOUD_SOURCES}")
-    estimate = daily_cloud_cover(frame, location)
     if cloud == "estimated":
-        return estimate
+        return daily_cloud_cover(frame, location)
     if CLOUD_COVER not in frame.columns or not frame[CLOUD_COVER].notna().any():
         raise ValueError(
             f"the sky's cloud cover is read from '{CLOUD_COVER}', absent from the data"
         )
     measured = frame[CLOUD_COVER].to_numpy(dtype=float) / 10.0
-    return np.where(np.isfinite(measured), measured, estimate)
+    if np.isfinite(measured).all():
+        return measured
+    return np.where(np.isfinite(measured), measured, daily_cloud_cover(frame, location))
 
 
 def daily_cloud_cover(frame: pd.DataFrame, location: Location) -> np.ndarray:
