@@ -28,7 +28,9 @@ from rcengine.io.timeseries import read_timeseries
 from scripts.energyplus.archetypes import ARCHETYPES
 from scripts.energyplus.testbed import (
     CASES,
+    FIRST_SET_WITH_HEATING_FLOOR,
     FRESH_CASES,
+    MIN_HEATING_KWH_M2,
     SEALED_SEEDS,
     SEALED_SETS,
     SETS,
@@ -193,6 +195,18 @@ def test_a_further_set_is_held_out_whole_and_covers_every_effect(
         assert e["magnitude"] == (magnitude if e["effects"] else None)
         for effect in e["effects"]:
             assert e["strength"][effect]["rms_t_in_K"] >= MIN_RMS_K, (e["case"], effect)
+
+
+@pytest.mark.parametrize(
+    "name", list(SEALED_SEEDS)[list(SEALED_SEEDS).index(FIRST_SET_WITH_HEATING_FLOOR) :]
+)
+def test_every_case_of_a_newer_set_heats(project_data: Path, name: str) -> None:
+    """From the eleventh sealed set on, every case heats at least the floor per m² of floor."""
+    folder = project_data / name
+    for e in json.loads((folder / "manifest.json").read_text()):
+        building = json.loads((folder / e["case"] / "building.json").read_text())
+        per_m2 = e["heating"]["energy_kWh"] / building["floor_area"]
+        assert per_m2 >= MIN_HEATING_KWH_M2, (e["case"], round(per_m2, 2))
 
 
 def test_the_fresh_set_stands_on_new_ground(project_data: Path, manifest: list[dict]) -> None:
