@@ -156,8 +156,9 @@ CASES = {
     ),
     "emitter_dynamics": Case(
         lambda e: {"c_emitter": 2e4, "r_emitter": 0.2},
-        lambda e: {"c_emitter": 1e5, "r_emitter": 1.0},
-        "emitter time constant: 27.8 h exceeds any emitter (fan coil to screeded floor) (≤ 24 h)",
+        lambda e: {"c_emitter": 2e5, "r_emitter": 1.0},
+        "emitter time constant: 55.6 h exceeds any emitter (fan coil to thermally activated slab) "
+        "(≤ 33.5 h)",
     ),
 }
 
@@ -210,6 +211,19 @@ def test_a_gain_small_beside_the_metered_gains_is_rejected(gain_context):
     assert small.problems == [
         "unmetered gain as a share of the metered gains (q_occ + q_light) in its hours: 0.2 is "
         "below any gain the metered gains' own uncertainty leaves room for (≥ 0.333)"
+    ]
+
+
+def test_an_emitter_may_charge_the_slab_it_lies_on(gain_context, loss_context):
+    """A heating mat on an uninsulated 200 mm slab under 90 mm of screed stores in both (≈ 580
+    kJ/(m²K)); the heaviest emitter is a thermally activated 0.3 m slab, and past it nothing."""
+    ext = _built("emitter_dynamics", gain_context, loss_context)
+    slab = 0.2 * 2240.0 * 900.0 + 0.09 * 2000.0 * 1000.0
+    assert assess(ext, {**TRUTH_BASIC, "c_emitter": slab, "r_emitter": 0.16}).plausible
+    heavier = assess(ext, {**TRUTH_BASIC, "c_emitter": 8e5, "r_emitter": 0.1})
+    assert heavier.problems == [
+        "emitter heat capacity per m² of floor: 800 kJ/(m²K) exceeds any emitter (a thermally "
+        "activated slab included) (≤ 720 kJ/(m²K))"
     ]
 
 

@@ -775,7 +775,7 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
             "c_emitter",
             "J/(K·m²)",
             1e2,
-            5e5,  # past any emitter's (plausibility.EMITTER_CAPACITY_J_M2K)
+            1e6,  # past any emitter's (plausibility.EMITTER_CAPACITY_J_M2K)
             "heat capacity of the emitter (water, metal, screed), per floor area",
         )
     )
