@@ -90,24 +90,6 @@ def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
     assert steady.folds["helped"] == 3 and steady.folds["pooled_rmse_test_before"] == 1.0
 
 
-def test_an_effect_too_slow_for_the_folds_keeps_the_single_split_s_verdict():
-    folds = rolling_folds(
-        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
-    )
-    evidence = _evidence([1, 1, 1], [1.1, 0.9, 1.05])
-    ground = _finding("ground_coupling", True)
-    confirm_on_folds(ground, evidence, folds, DiagnoseSettings(), "Europe/Rome", ("t_ground", 0.18))
-    assert ground.accepted and ground.detail["slow_input"]["signal"] == "t_ground"
-    assert "judged on the single split: its input t_ground varies within a fold's training " in (
-        ground.reason
-    )
-    assert "by 18% of its variation over the record" in ground.reason
-    assert "(across folds: helps in 1 of 3 folds" in ground.reason and ground.folds["helped"] == 1
-    fast = _finding("wind_infiltration", True)
-    confirm_on_folds(fast, evidence, folds, DiagnoseSettings(), "Europe/Rome")
-    assert not fast.accepted and "slow_input" not in fast.detail
-
-
 def test_a_fold_trained_without_heating_but_tested_with_it_is_left_out():
     times = pd.date_range("2016-10-01", "2017-01-01", freq="1h", tz="UTC")
     folds = rolling_folds(times, "Europe/Rome", 28, 14, 3)

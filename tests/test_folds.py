@@ -12,14 +12,12 @@ from rcengine.dataset import Dataset
 from rcengine.diagnose import selection
 from rcengine.diagnose.fitting import Split, carried_on, split_data, trust_region
 from rcengine.diagnose.folds import (
-    SLOW_INPUT_SHARE,
     Fold,
     FoldEvidence,
     FoldRule,
     head_to_head,
     judge_folds,
     rolling_folds,
-    within_fold_share,
 )
 from rcengine.diagnose.report import Finding
 from rcengine.diagnose.selection import Selection, _backward, _one_version_each
@@ -150,25 +148,6 @@ def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
     assert _one_version_each([first, refined]) == [refined]
 
 
-def test_a_seasonal_input_varies_too_little_within_a_fold_for_the_folds_to_judge_it():
-    """Over a heating season, four weeks see a fifth of a lagged annual cycle's variation; the
-    sun's daily cycle and a weekly schedule vary as much within them as over the record."""
-    times = _season()
-    days = ((times - times[0]) / DAY).to_numpy()
-    folds = rolling_folds(times, TZ, train_days=28, test_days=14, max_folds=6)
-
-    def share(signal: np.ndarray) -> float:
-        windows = [signal[(times >= f.train_start) & (times < f.test_start)] for f in folds]
-        return within_fold_share(signal, windows)
-
-    soil = 12.0 + 6.0 * np.cos(2 * np.pi * (days - 130.0) / 365.0)
-    sun = np.clip(np.sin(2 * np.pi * (days % 1.0 - 0.25)), 0.0, None)
-    weekdays = (times.tz_convert(TZ).day_of_week < 5).astype(float)
-    assert share(soil) < 0.3 < SLOW_INPUT_SHARE
-    assert share(sun) > 0.8 and share(weekdays) > 0.8
-    assert np.isnan(share(np.ones(len(times))))  # a constant says nothing
-
-
 def _accepted(effect: str, round_no: int, repair: bool = False) -> Finding:
     return Finding(effect, True, round_no, 0.0, "projection", 1.0, 1.0, baseline_repair=repair)
 
@@ -254,32 +233,6 @@ def test_the_backward_check_drops_the_least_worth_first_and_checks_again(monkeyp
     assert [f.effect for f in state.accepted] == ["thermal_mass", "ventilation_schedule"]
     assert set(state.verdicts) == {"wind_infiltration", "sky_radiation"}
     assert state.current == "final without wind_infiltration"
-
-
-def test_the_backward_check_keeps_a_finding_judged_on_the_single_split(monkeypatch):
-    # The ground entered on the single split (its soil temperature too slow for the folds); the
-    # folds, which could not judge it forward, cannot drop it backward either.
-    original = Finding.__init__
-
-    def marked(self, *args, **kwargs):
-        original(self, *args, **kwargs)
-        if self.effect == "ground_coupling":
-            self.detail["slow_input"] = {"signal": "t_ground", "within_fold_share": 0.18}
-
-    monkeypatch.setattr(Finding, "__init__", marked)
-    state = _backward_check(
-        {"ventilation_schedule": [1.5] * 4, "ground_coupling": [0.52, 0.49, 0.49, 0.52]},
-        monkeypatch,
-    )
-    assert [f.effect for f in state.accepted] == [
-        "thermal_mass",
-        "ventilation_schedule",
-        "ground_coupling",
-    ]
-    ground = state.accepted[2]
-    assert ground.backward["still_needed"] is False
-    assert ground.backward["reason"].endswith("kept: judged on the single split (a slow input)")
-    assert state.current == "final" and not state.verdicts
 
 
 def test_a_fold_refit_stays_near_the_fit_on_the_training_half():

@@ -10,7 +10,6 @@ effect of physics helps in most of them, a seasonal coincidence in few.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -160,23 +159,6 @@ class FoldRule:
 
     min_share: float = 0.5
     min_improvement: float = 0.10
-
-
-# An input that varies within a fold's training weeks by less than this share of its variation
-# over the record changes too slowly for a four-week refit to tell its effect from the base
-# model's own parameters: the ground's seasonal temperature varies there by 16–19 % of its
-# variation over a heating season, the sun, wind and learnt schedules by most of theirs. Such an
-# effect is judged on the single split's half season; the folds' evidence is recorded beside it.
-SLOW_INPUT_SHARE = 0.5
-
-
-def within_fold_share(record: np.ndarray, windows: Sequence[np.ndarray]) -> float:
-    """The median over ``windows`` (the folds' training rows) of an input's standard deviation,
-    as a share of its standard deviation over ``record``; nan for an input constant there."""
-    whole = float(np.nanstd(record))
-    if not whole > 1e-9:
-        return float("nan")
-    return float(np.median([np.nanstd(w) for w in windows])) / whole
 
 
 def judge_folds(evidence: FoldEvidence, rule: FoldRule) -> tuple[bool, str]:

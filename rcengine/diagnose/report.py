@@ -182,30 +182,19 @@ def confirm_on_folds(
     folds: list[Fold],
     settings: DiagnoseSettings,
     timezone: str,
-    slow: tuple[str, float] | None = None,
 ) -> None:
     """Keep a finding that passed the single split accepted only if it also helps in most folds
-    and on their pooled test; the fold evidence goes into the finding either way. ``slow`` (an
-    input and its ``within_fold_share``) marks an effect too slow for the folds to judge: the
-    single split's verdict stands, and the reason says why."""
+    and on their pooled test; the fold evidence goes into the finding either way."""
     ok, text = judge_folds(evidence, settings.fold_rule)
     finding.evidence = evidence
     finding.folds = evidence.to_dict(folds, timezone)
     single = finding.reason.removeprefix("accepted: ")
-    finding.accepted = ok or slow is not None
-    if slow is not None:
-        signal, share = slow
-        finding.detail["slow_input"] = {"signal": signal, "within_fold_share": share}
-    if ok:
-        finding.reason = f"accepted: {single}; across folds: {text}"
-    elif slow is not None:
-        finding.reason = (
-            f"accepted: {single}; judged on the single split: its input {signal} varies within "
-            f"a fold's training weeks by {share:.0%} of its variation over the record, too "
-            f"slowly for a refit on them to tell it from the base model (across folds: {text})"
-        )
-    else:
-        finding.reason = f"rejected across folds: {text} (single split: {single})"
+    finding.accepted = ok
+    finding.reason = (
+        f"accepted: {single}; across folds: {text}"
+        if ok
+        else f"rejected across folds: {text} (single split: {single})"
+    )
 
 
 def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: list[str]) -> None:

@@ -26,7 +26,6 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
@@ -44,13 +43,11 @@ from rcengine.diagnose.fitting import (
     trust_region,
 )
 from rcengine.diagnose.folds import (
-    SLOW_INPUT_SHARE,
     Fold,
     FoldEvidence,
     head_to_head,
     judge_folds,
     rolling_folds,
-    within_fold_share,
 )
 from rcengine.diagnose.health import FitQuality, Health, check_health, fit_quality
 from rcengine.diagnose.locate import summarize
@@ -518,7 +515,7 @@ def _confirm_on_folds(
     problem.say(f"  confirming {', '.join(names)} on {len(problem.folds)} rolling folds")
     fits = _fold_fits_beside_current(problem, state, models)
     before = tuple(f.residual_test for f in state.current_folds)
-    for (ext, finding), fold_fits in zip(passing, fits, strict=True):
+    for (_, finding), fold_fits in zip(passing, fits, strict=True):
         after = tuple(f.residual_test for f in fold_fits)
         confirm_on_folds(
             finding,
@@ -526,25 +523,7 @@ def _confirm_on_folds(
             problem.folds,
             problem.settings,
             problem.building.location.timezone,
-            _slow_input(ext, finding.fit, fold_fits),
         )
-
-
-def _slow_input(ext: Extension, fit: Fit, fold_fits: list[Fit]) -> tuple[str, float] | None:
-    """The extension's input that varies most within the folds' training weeks, with that
-    share of its variation over the record (``within_fold_share``), when even it varies less
-    than ``SLOW_INPUT_SHARE``; None for a structural extension or a fast input."""
-    shares: dict[str, float] = {}
-    for signal, _ in ext.inputs:
-        record = pd.concat([fit.split.train.frame[signal], fit.split.test.frame[signal]])
-        windows = [f.split.train.frame[signal].to_numpy(dtype=float) for f in fold_fits]
-        share = within_fold_share(record.to_numpy(dtype=float), windows)
-        if np.isfinite(share):
-            shares[signal] = share
-    if not shares or max(shares.values()) >= SLOW_INPUT_SHARE:
-        return None
-    fastest = max(shares, key=shares.__getitem__)
-    return fastest, shares[fastest]
 
 
 def _fold_fits_beside_current(
@@ -597,11 +576,10 @@ def _backward(problem: Problem, state: Selection) -> None:
     a better optimum of the parameters it did not add: the last finding too is checked, since the
     model without it, refitted from the final parameters, need not be the one it was judged
     against. The finding that no longer helps across the folds (``FoldRule``, the rule it
-    entered by; one whose input is too slow for the folds, ``_slow_input``, stays, as it
-    entered on the single split) and is worth least is dropped and the check repeated on the
-    model without it; the findings kept are ordered by what leaving each out costs on the
-    folds' pooled test, the one that matters most first. Steps taken to make the base model
-    healthy are not candidates and stay first.
+    entered by) and is worth least is dropped and the check repeated on the model without it;
+    the findings kept are ordered by what leaving each out costs on the folds' pooled test, the
+    one that matters most first. Steps taken to make the base model healthy are not candidates
+    and stay first.
     """
     rule, timezone = problem.settings.fold_rule, problem.building.location.timezone
     while problem.folds:
@@ -617,9 +595,7 @@ def _backward(problem: Problem, state: Selection) -> None:
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
             finding.backward = {**ev.to_dict(problem.folds, timezone), "still_needed": ok}
             finding.backward["reason"] = f"added last, to the other findings: {text}"
-            if not ok and "slow_input" in finding.detail:
-                finding.backward["reason"] += "; kept: judged on the single split (a slow input)"
-            elif not ok:
+            if not ok:
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
         if not failing:
