@@ -493,6 +493,8 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 # ``MIN_HEATING_KWH_M2`` over the season (checked in tests/test_testbed.py): an office that
 # barely heats — the ninth set's heavy San Francisco null, 0.03 kWh/m² — has a q_hvac of zeros
 # that tells nothing of its heat loss, and the issue asks for heating with setbacks.
+MIN_HEATING_KWH_M2 = 1.0
+FIRST_SET_WITH_HEATING_FLOOR = "testbed_sealed_11"
 SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed": SEALED_SEED,
     "testbed_sealed_2": SEALED_SEED + 1,
@@ -507,8 +509,6 @@ SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed_11": SEALED_SEED + 24,
     "testbed_sealed_12": SEALED_SEED + 27,
 }
-MIN_HEATING_KWH_M2 = 1.0
-FIRST_SET_WITH_HEATING_FLOOR = "testbed_sealed_11"
 SEALED_SETS: dict[str, tuple[Case, ...]] = {
     name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
 }
