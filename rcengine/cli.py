@@ -29,6 +29,7 @@ import pandas as pd
 import typer
 
 from rcengine.building import Building
+from rcengine.dataset import bridge_short_gaps
 from rcengine.estimation import PRESETS, Estimator, settings_for
 from rcengine.estimation.estimator import CRITERIA, check_criterion
 from rcengine.estimation.likelihood import LikelihoodFit
@@ -137,7 +138,7 @@ def fit(
     def run() -> None:
         b = Building.from_json(building)
         first, last = _period(start, end, b.location.timezone)
-        frame = read_timeseries(data)
+        frame = bridge_short_gaps(read_timeseries(data))
         name, net, options = _model_to_fit(model, model_file, b, frame, sky_model)
         options = replace(options, input_hold=input_hold)
         dataset = prepare(frame, b, net.compile().input_names, options).between(first, last)

@@ -3,6 +3,12 @@
 Rows are on a regular step; a missing row (a gap, or weekends removed as in the thesis's
 "Selected period") starts a new segment. Each segment is simulated from its own initial state, so
 a Friday-to-Monday jump is never taken for model error (the flaw of thesis §3.2).
+
+A fit bridges short gaps first (``bridge_short_gaps``): a building does not stop between two
+readings, and a segment restarted after every dropped reading would have the states of its
+slow nodes estimated afresh from each stretch — hundreds of free initial temperatures for a
+sensor that drops 3 % of its rows, which absorb exactly the slow physics a diagnosis looks for
+and multiply the cost of every simulation.
 """
 
 from __future__ import annotations
@@ -18,6 +24,12 @@ from rcengine.columns import T_IN
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.instants import parse_instant
 from rcengine.statespace import check_hold
+
+# Longest stretch of missing rows a fit bridges by interpolating the inputs. A room's air answers
+# within its own time constant (c_air·r: minutes to an hour), so an hour of interpolated weather
+# and heat errs by little more than the readings' own noise; longer outages (a logger down for a
+# day, the thesis's weekends) start a new segment. [s]
+MAX_BRIDGED_GAP_S = 3600.0
 
 
 @dataclass(frozen=True)
@@ -127,3 +139,36 @@ class Dataset:
 def _step_seconds(index: pd.DatetimeIndex) -> np.ndarray:
     """Differences between consecutive times. [s]"""
     return np.diff(index.as_unit("ns").asi8) / 1e9
+
+
+def bridge_short_gaps(
+    frame: pd.DataFrame, max_gap_s: float = MAX_BRIDGED_GAP_S, step_s: float | None = None
+) -> pd.DataFrame:
+    """``frame`` (tz-aware index, regular step) with every run of missing rows lasting at most
+    ``max_gap_s`` restored: the inputs interpolated linearly in time between the rows either
+    side, ``t_in`` left unmeasured (NaN), so the states run on across the gap and nothing unseen
+    is scored. Longer gaps stay gaps.
+
+    Parameters
+    ----------
+    frame : contract columns (and any others) on a regular step.
+    max_gap_s : longest missing stretch bridged. [s]
+    step_s : the step; default the most common difference between rows. [s]
+    """
+    if len(frame) < 2:
+        return frame
+    step = step_s or Dataset.from_frame(frame).step_s
+    index = frame.index.as_unit("ns")
+    diffs = _step_seconds(index)
+    missing = np.round(diffs / step).astype(int) - 1
+    bridged = np.flatnonzero((missing > 0) & (missing * step <= max_gap_s + 1e-6))
+    if not bridged.size:
+        return frame
+    delta = pd.Timedelta(seconds=step)
+    runs = [pd.date_range(index[i] + delta, periods=missing[i], freq=delta) for i in bridged]
+    inserted = runs[0].append(runs[1:]).tz_convert(frame.index.tz)
+    full = frame.reindex(frame.index.union(inserted))
+    numeric = [c for c in full.columns if c != T_IN and pd.api.types.is_numeric_dtype(full[c])]
+    interpolated = full[numeric].interpolate(method="time", limit_area="inside")
+    full.loc[inserted, numeric] = interpolated.loc[inserted]
+    return full

@@ -32,6 +32,7 @@ from sqlalchemy.orm import Session
 
 from rcengine.building import Building
 from rcengine.columns import T_IN
+from rcengine.dataset import bridge_short_gaps
 from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ConvergenceWarning, RCEngineError
 from rcengine.forecast import forecast
@@ -213,7 +214,7 @@ def fit_parameter_set(
     else:
         check_columns(spec, training.columns)
         network, signals, model = spec.network(building), spec.signals, spec.name
-    data = prepare(training, building, network.compile().input_names, signals)
+    data = prepare(bridge_short_gaps(training), building, network.compile().input_names, signals)
     # The set records its parameters on bounds (``fit.at_bounds``), which promotion reads.
     estimator = Estimator(
         network,
