@@ -172,3 +172,32 @@ def bridge_short_gaps(
     interpolated = full[numeric].interpolate(method="time", limit_area="inside")
     full.loc[inserted, numeric] = interpolated.loc[inserted]
     return full
+
+
+def aggregated(
+    frame: pd.DataFrame, step_s: float, record_step_s: float | None = None
+) -> pd.DataFrame:
+    """``frame`` averaged into intervals of at least ``step_s`` when its own step is finer.
+
+    Rows are interval means (the contract), so the mean of the rows inside a coarser interval is
+    that interval's mean: each input's heat over it is kept. The interval is the smallest whole
+    multiple of the record's step reaching ``step_s``, counted from the first row; ``t_in`` is
+    the mean of the rows that measured it, an interval without rows is left out (a gap), and
+    non-numeric columns are dropped.
+
+    Parameters
+    ----------
+    frame : contract columns (tz-aware index, regular step).
+    step_s : the finest step wanted. [s]
+    record_step_s : the record's step; default the most common difference between rows. [s]
+    """
+    if len(frame) < 2:
+        return frame
+    step = record_step_s or Dataset.from_frame(frame).step_s
+    factor = int(np.ceil(step_s / step - 1e-9))
+    if factor <= 1:
+        return frame
+    numeric = frame.select_dtypes("number")
+    bins = numeric.resample(pd.Timedelta(seconds=factor * step), origin="start")
+    means, rows = bins.mean(), bins.size()
+    return means[rows.to_numpy() > 0]

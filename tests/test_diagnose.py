@@ -184,6 +184,20 @@ def test_hidden_weekly_gain_is_found_named_and_fixed(hidden_gain_record):
     assert "unmetered_gains" in html and "<img" in html
 
 
+def test_a_five_minute_record_is_judged_at_a_quarter_hour(hidden_gain_record):
+    """The same building logged every 5 minutes (inputs held, t_in interpolated): averaged into
+    15-minute means before it is judged, and the hidden gain is still what is found."""
+    fine_times = pd.date_range(
+        hidden_gain_record.index[0], hidden_gain_record.index[-1], freq="5min"
+    )
+    fine = hidden_gain_record.reindex(fine_times).ffill()
+    fine["t_in"] = hidden_gain_record["t_in"].reindex(fine_times).interpolate()
+    report = diagnose(fine, BUILDING, "basic", DiagnoseSettings(train_fraction=0.6))
+    d = report.to_dict()
+    assert d["periods"]["step_s"] == 900.0
+    assert next(f["effect"] for f in d["findings"] if f["accepted"]) == "unmetered_gains"
+
+
 VARIANTS = Path(__file__).resolve().parents[1] / "data" / "energyplus" / "variants"
 MANIFEST = {c["case"]: c for c in json.loads((VARIANTS / "manifest.json").read_text())}
 

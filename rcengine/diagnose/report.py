@@ -421,6 +421,7 @@ class Report:
             "skipped": self.skipped,
             "whiteness": self.whiteness,
             "periods": {
+                "step_s": split.train.step_s,
                 "train": [split.train.times[0].isoformat(), self.boundary.isoformat()],
                 "test": [
                     self.boundary.isoformat(),

@@ -30,7 +30,7 @@ import pandas as pd
 
 from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
-from rcengine.dataset import bridge_short_gaps
+from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
 from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.fitting import (
@@ -150,7 +150,7 @@ def _diagnose(
     progress: Callable[[str], None] | None,
 ) -> Report:
     started = time.perf_counter()
-    frame = bridge_short_gaps(frame)
+    frame = aggregated(bridge_short_gaps(frame), settings.min_step_s)
     timezone = building.location.timezone
     boundary = split_time(frame, settings.train_fraction, timezone)
     check_diagnosable(frame, boundary)
