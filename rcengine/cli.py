@@ -112,7 +112,7 @@ def fit(
     ] = None,
     start: Annotated[str | None, typer.Option(help=f"first time fitted: {WHEN}")] = None,
     end: Annotated[str | None, typer.Option(help=f"end of the fit (exclusive): {WHEN}")] = None,
-    preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "default",
+    preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "thorough",
     weekdays: Annotated[bool, typer.Option(help="fit Monday–Friday only")] = False,
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
     sky_model: Annotated[str, typer.Option(help="isotropic | perez | haydavies")] = "isotropic",

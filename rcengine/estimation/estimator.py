@@ -123,7 +123,8 @@ class Estimator:
     initial_states_ : estimated node temperatures at the start of each segment [°C].
     n_simulations_ : parameter sets simulated; wall_time_s_ : fit duration [s].
     at_bounds_ : free parameters that ended on a bound.
-    ga_, gps_ : optimiser results; polish_ : dict or None.
+    ga_, gps_ : optimiser results (of the best restart); polish_ : dict or None;
+    restart_costs_ : the final cost of each independent search (``EstimatorSettings.restarts``).
     noise_ : the fitted ``Noise`` ("likelihood"; None otherwise); likelihood_ : ``LikelihoodFit``
         with standard errors, correlations and residual checks, or None.
     """
@@ -163,6 +164,7 @@ class Estimator:
         objective = Objective(network, data, self.cost)
         rng = np.random.default_rng(self.random_state)
         self.ga_ = self.gps_ = self.polish_ = self.likelihood_ = self.noise_ = None
+        self.restart_costs_: list[float] = []
         if self.criterion == "likelihood":
             theta, best = self._fit_likelihood(network, data, space, settings, rng)
         else:
@@ -203,14 +205,25 @@ class Estimator:
             return objective(space.to_physical(unit))
 
         if space.dim == 0:
-            x, best = np.zeros(0), float(cost(np.zeros((1, 0)))[0])
-        else:
-            seeds = space.seeds(self.warm_start or [])
-            self.ga_, self.gps_ = search(cost, space.dim, settings, rng, seeds)
-            x, best = self.gps_.x, self.gps_.cost
+            return space.to_physical(np.zeros(0))[0], float(cost(np.zeros((1, 0)))[0])
+        seeds = space.seeds(self.warm_start or [])
+        # The first search draws from ``rng`` alone, as a single search would: more restarts can
+        # only lower the cost.
+        streams = [rng]
+        winner: tuple = ()
+        for k in range(max(1, settings.restarts)):
+            if k == 1:
+                streams += rng.spawn(settings.restarts - 1)
+            self.polish_ = None
+            ga_result, gps_result = search(cost, space.dim, settings, streams[k], seeds)
+            x, best = gps_result.x, gps_result.cost
             if settings.polish:
-                starts = [x, *self.ga_.archive[1 : settings.polish_starts]]
+                starts = [x, *ga_result.archive[1 : settings.polish_starts]]
                 x, best = self._polish(objective, space, starts, best)
+            self.restart_costs_.append(best)
+            if not winner or best < winner[1]:
+                winner = (x, best, ga_result, gps_result, self.polish_)
+        x, best, self.ga_, self.gps_, self.polish_ = winner
         return space.to_physical(x)[0], best
 
     def _fit_likelihood(

@@ -149,13 +149,14 @@ def test_worse_fit_is_stored_rejected_and_never_current(client, measured, synthe
 
 
 def test_no_worse_fit_is_promoted_and_the_old_set_superseded(client, measured):
-    """Same data and seed: the same set, equal held-out RMSE, which counts as no worse."""
+    """Same data and seed, the search seeded with the current set: the same optimum to the
+    polish's tolerance, an equal held-out RMSE, which counts as no worse."""
     building_id, headers = measured
     first = calibrate(client, building_id, headers)
     second = calibrate(client, building_id, headers)
     assert second["outcome"] == "promoted"
     assert second["details"]["holdout"]["new"]["rmse"] == pytest.approx(
-        second["details"]["holdout"]["current"]["rmse"], rel=1e-9
+        second["details"]["holdout"]["current"]["rmse"], rel=1e-5
     )
     statuses = {s["id"]: s["status"] for s in parameter_sets(client, building_id, headers)["items"]}
     assert statuses == {
@@ -264,3 +265,28 @@ def test_broken_pool_is_replaced_and_the_job_still_runs(client, measured):
     job = calibrate(client, building_id, headers)
     assert (job["status"], job["outcome"]) == ("succeeded", "promoted")
     assert not isinstance(runner._executor, BrokenPool)
+
+
+def test_a_nightly_fit_starts_from_the_current_sets_basin(project_data):
+    """A test-bed fortnight on which one search from seed 3 settles in the worse of two basins
+    (+22 % RMSE): seeded with the current set's parameters, the same search ends in the better,
+    and a current set of another model seeds nothing."""
+    from rcengine.building import Building
+    from rcengine.io.timeseries import read_timeseries
+
+    case = project_data / "testbed_sealed_12" / "open_plan-golden-null"
+    building = Building.from_json(case / "building.json")
+    frame = read_timeseries(case / "data.csv")
+    training = frame[frame.index < frame.index[0] + pd.Timedelta(days=14)]
+    options = calibration.CalibrationOptions(random_state=3)
+    fresh = calibration.fit_parameter_set(training, building, "basic", options)
+    good = calibration.fit_parameter_set(
+        training, building, "basic", replace(options, random_state=0)
+    )
+    assert fresh.metrics["train"]["rmse"] > 1.15 * good.metrics["train"]["rmse"]
+    inputs = calibration.Inputs(building, "basic", None, training, good, 1)
+    warm = calibration.fit_parameter_set(
+        training, building, "basic", options, warm_start=calibration._warm(inputs)
+    )
+    assert warm.metrics["train"]["rmse"] == pytest.approx(good.metrics["train"]["rmse"], rel=0.01)
+    assert calibration._warm(replace(inputs, model="sun")) is None
