@@ -70,3 +70,20 @@ def test_candidate_trajectories_equal_one_by_one_simulation(four_days):
         y_n, _ = model.simulate(u_n, x0)
         np.testing.assert_allclose(batch[n], y_n, atol=1e-9)
     assert pd.Series(batch[1]).notna().all()
+
+
+def test_a_dropped_reading_before_the_start_does_not_cut_the_filters_history(four_days):
+    """One row missing 3 h before the start: the filter runs on across it (inputs interpolated,
+    no measurement) and the slow states still come from the whole history; cut there, the
+    filter would know only the last 3 h."""
+    net = get_model("basic", BUILDING).compile()
+    start = four_days.times[2 * 96]
+    truth = four_days.frame["t_in"].to_numpy()[2 * 96 : 3 * 96]
+    gapped = Dataset(four_days.frame.drop(start - pd.Timedelta(hours=3)), 900.0)
+
+    def error(data: Dataset, history_h: float) -> float:
+        fc = forecast(net, TRUTH_BASIC, data, start, hours=24, history_h=history_h)
+        return float(np.sqrt(np.mean((fc.t_in_pred - truth) ** 2)))
+
+    assert error(gapped, 48.0) == pytest.approx(error(four_days, 48.0), abs=1e-3)
+    assert error(gapped, 48.0) < 0.01 < 0.1 < error(four_days, 2.75)
