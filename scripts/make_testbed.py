@@ -17,6 +17,7 @@
     python scripts/make_testbed.py --set testbed_sealed_10  # the tenth (drawn, diagnosed once)
     python scripts/make_testbed.py --set testbed_sealed_11  # the eleventh (drawn, diagnosed once)
     python scripts/make_testbed.py --set testbed_sealed_12  # the twelfth (drawn, diagnosed once)
+    python scripts/make_testbed.py --set testbed_sealed_13  # the thirteenth (drawn, not diagnosed)
 
 Writes ``<case>/data.csv`` and ``<case>/building.json`` per case, ``manifest.json`` (archetype,
 climate, rotation, concealed effects with their physical magnitudes and measured strengths) and
