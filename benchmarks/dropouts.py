@@ -22,12 +22,14 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+import pandas as pd
 
 from rcengine.building import Building
 from rcengine.dataset import bridge_short_gaps
 from rcengine.estimation.estimator import Estimator
 from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
+from rcengine.network import RCNetwork
 from rcengine.signals import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -41,7 +43,7 @@ CASES = [
 ]
 
 
-def _fit(frame, building, network) -> dict:
+def _fit(frame: pd.DataFrame, building: Building, network: RCNetwork) -> dict:
     data = prepare(frame, building, network.compile().input_names)
     started = time.perf_counter()
     est = Estimator(network, random_state=0, warn_bounds=False).fit(data)

@@ -21,6 +21,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+import pandas as pd
 
 from rcengine.building import Building
 from rcengine.estimation.estimator import Estimator
@@ -35,7 +36,7 @@ TESTBED = ROOT / "data" / "testbed_sealed_12"
 ARMADILLO = ROOT.parent / "shared" / "data" / "measured" / "armadillo_data_H2.csv"
 
 
-def _records() -> list[tuple[str, Building, object]]:
+def _records() -> list[tuple[str, Building, pd.DataFrame]]:
     out = []
     for name in ("open_plan-golden-null", "light-sanfrancisco-emitter_dynamics-drawn"):
         frame = read_timeseries(TESTBED / name / "data.csv")
