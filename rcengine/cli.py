@@ -291,6 +291,12 @@ def diagnose(
             f"final {d['final']['model']}: test RMSE {d['final']['rmse_test']:.3f} K "
             f"({report.wall_time_s:.1f} s)"
         )
+        ahead = d["day_ahead"]
+        if ahead and ahead["rmse_baseline"] is not None:
+            typer.echo(
+                f"day-ahead forecast RMSE over the test half's {ahead['days']} days: "
+                f"{ahead['rmse_baseline']:.3f} K (baseline) → {ahead['rmse_final']:.3f} K (final)"
+            )
         if json_out:
             json_out.write_text(report.to_json() + "\n")
             typer.echo(f"wrote {json_out}")

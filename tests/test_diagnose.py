@@ -180,8 +180,13 @@ def test_hidden_weekly_gain_is_found_named_and_fixed(hidden_gain_record):
     # The hidden gain switches on at 07:00 on weekdays: the one-step errors are largest then.
     assert np.nanargmax(np.nanmean(innovations[:5], axis=0)) in (7, 8)
     assert d["final"]["model"].startswith("basic+unmetered_gains")
+    # What the MPC would have been served over the test half's days: the gain helps there too.
+    ahead = d["day_ahead"]
+    assert ahead["days"] >= 7 and ahead["horizon_h"] == 24.0
+    assert ahead["rmse_final"] < 0.7 * ahead["rmse_baseline"]
     html = render(report)
     assert "unmetered_gains" in html and "<img" in html
+    assert "as the service forecasts for an MPC" in html
 
 
 def test_a_five_minute_record_is_judged_at_a_quarter_hour(hidden_gain_record):

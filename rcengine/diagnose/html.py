@@ -199,6 +199,19 @@ def _folds_table(title: str, folds: dict | None) -> str:
     )
 
 
+def _day_ahead(d: dict) -> str:
+    """The base and final models' day-ahead forecasts over the test half, as an MPC gets them."""
+    block = d.get("day_ahead")
+    if not block or block.get("rmse_baseline") is None:
+        return ""
+    return (
+        f"<p>Forecast {block['horizon_h']:g} h ahead from each local midnight of the test half "
+        f"({block['days']} days, the state filtered from the {block['history_h']:g} h before), "
+        f"as the service forecasts for an MPC: RMSE {block['rmse_baseline']:.3f} K with the "
+        f"base model, {block['rmse_final']:.3f} K with the final one.</p>"
+    )
+
+
 def _no_folds(d: dict) -> str:
     if d["evidence"]["method"] == "split":
         return "<p>Judged on the single split alone (no folds asked for, or a short record).</p>"
@@ -248,7 +261,7 @@ def render(report: Report) -> str:
 test RMSE {d["baseline"]["rmse_test"]:.3f} K. Final <b>{esc(d["final"]["model"])}</b>:
 train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
 Training {esc(day(d["periods"]["train"][0]))} – {esc(day(d["periods"]["train"][1]))},
-test until {esc(day(d["periods"]["test"][1]))}.</p>
+test until {esc(day(d["periods"]["test"][1]))}.</p>{_day_ahead(d)}
 <p>Where and when: {esc(d["mismatch"]["summary"])}.</p></div>
 <h2>Measured vs predicted</h2>{_png(timeseries_figure(report))}
 <h2>Where the errors concentrate</h2>{_png(heatmaps_figure(report))}

@@ -352,7 +352,8 @@ class Report:
     """The diagnosis: ``health`` and ``quality`` of the base model as given, ``repair`` the
     outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
     extension had to help across (none: judged on the single split), ``folds_left_out`` those
-    whose training window barely ran the HVAC its test window ran."""
+    whose training window barely ran the HVAC its test window ran; ``day_ahead`` the base and
+    final models' day-ahead forecasts over the test half (``diagnose.day_ahead``)."""
 
     building: Building
     model: str
@@ -369,6 +370,7 @@ class Report:
     repair: dict | None = None
     folds: list[Fold] = field(default_factory=list)
     folds_left_out: list[Fold] = field(default_factory=list)
+    day_ahead: dict | None = None
 
     @property
     def accepted(self) -> list[Finding]:
@@ -420,6 +422,7 @@ class Report:
             },
             "skipped": self.skipped,
             "whiteness": self.whiteness,
+            "day_ahead": self.day_ahead,
             "periods": {
                 "step_s": split.train.step_s,
                 "train": [split.train.times[0].isoformat(), self.boundary.isoformat()],

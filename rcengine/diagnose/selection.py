@@ -32,6 +32,7 @@ from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
 from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
+from rcengine.diagnose.day_ahead import day_ahead_block
 from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.fitting import (
     Fit,
@@ -175,6 +176,8 @@ def _diagnose(
         "baseline": ljung_box(baseline.innovations_test, baseline.split.test.times),
         "final": ljung_box(state.current.innovations_test, state.current.split.test.times),
     }
+    problem.say("forecasting the test half day by day")
+    day_ahead = day_ahead_block(baseline, state.current, timezone)
     return Report(
         building,
         model,
@@ -191,6 +194,7 @@ def _diagnose(
         state.repair,
         folds,
         left_out,
+        day_ahead,
     )
 
 
