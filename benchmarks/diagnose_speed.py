@@ -5,9 +5,11 @@
 Each variant (data/energyplus/variants/, made by scripts/make_energyplus_data.py) hides exactly
 one effect of the vocabulary — never as a column — or none ("plain"). A case is correct when the
 first accepted finding is the hidden effect and the final model's test RMSE is at most 0.7 × the
-baseline's, or, for "plain", when nothing is accepted. With ``--out`` the JSON reports, their
-figures (PNG) and a markdown table are written there (``rcengine diagnose --html`` gives the full
-HTML report of one case). Last line: JSON {"cases", "wall_s_per_case", "correct"}.
+baseline's, or, for "plain", when nothing is accepted. The table also gives the base and final
+models' day-ahead forecast RMSE over the test half (the report's ``day_ahead``). With ``--out``
+the JSON reports, their figures (PNG) and a markdown table are written there (``rcengine
+diagnose --html`` gives the full HTML report of one case). Last line: JSON {"cases",
+"wall_s_per_case", "correct"}.
 """
 
 from __future__ import annotations
@@ -37,9 +39,11 @@ def is_correct(effect: str | None, report: dict) -> bool:
 def table_row(case: dict, report: dict, wall: float, correct: bool) -> str:
     accepted = accepted_effects(report)
     base, final = report["baseline"]["rmse_test"], report["final"]["rmse_test"]
+    ahead = report["day_ahead"]
     return (
         f"| {case['case']} | {case['effect'] or '—'} | {accepted[0] if accepted else 'none'} | "
         f"{', '.join(accepted[1:]) or '—'} | {base:.3f} | {final:.3f} | {final / base:.2f} | "
+        f"{ahead['rmse_baseline']:.3f} | {ahead['rmse_final']:.3f} | "
         f"{wall:.0f} | {'yes' if correct else 'NO'} |"
     )
 
@@ -74,8 +78,8 @@ def main() -> None:
         args.out.mkdir(parents=True, exist_ok=True)
     rows = [
         "| case | concealed effect | first finding | further findings | test RMSE before [K] "
-        "| after [K] | ratio | wall [s] | correct |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| after [K] | ratio | day-ahead before [K] | after [K] | wall [s] | correct |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     walls, correct, sections = [], 0, []
     for case in cases:

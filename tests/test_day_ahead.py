@@ -68,3 +68,13 @@ def test_days_an_outage_cuts_are_not_forecast(record):
     network, split = _split(gappy)
     _, fewer = day_ahead_errors(network, TRUTH_BASIC, split, zone)
     assert fewer == days - 2
+
+
+def test_rows_stamped_off_the_hour_start_each_day_at_its_first_row(record):
+    """SYSLAB's rows fall at :11, :26, ...: no row at midnight, yet every day is forecast."""
+    network, split = _split(record)
+    _, days = day_ahead_errors(network, TRUTH_BASIC, split, BUILDING.location.timezone)
+    shifted = record.set_axis(record.index + pd.Timedelta(minutes=11))
+    network, split = _split(shifted)
+    _, shifted_days = day_ahead_errors(network, TRUTH_BASIC, split, BUILDING.location.timezone)
+    assert shifted_days == days == TEST_DAYS

@@ -41,18 +41,23 @@ def day_ahead_errors(
     history_h: float = DEFAULT_HISTORY_H,
 ) -> tuple[np.ndarray, int]:
     """measured − forecast t_in over ``split.test`` [K] of ``network`` with ``params``, each
-    forecast starting at a local midnight of the test rows and running ``horizon_h`` hours (NaN
-    where unmeasured), and the number of days forecast. A midnight without a measurement in the
-    step before it, or whose horizon runs past the record, is skipped."""
+    forecast starting at a local midnight of the test rows (the day's first row within a step of
+    it) and running ``horizon_h`` hours (NaN where unmeasured), and the number of days forecast.
+    A day without a measurement in the step before its start, or whose horizon runs past the
+    record, is skipped."""
     train, test = split.train, split.test
     whole = Dataset(pd.concat([train.frame, test.frame]), test.step_s, test.hold)
     compiled = network.compile()
+    step = pd.Timedelta(seconds=test.step_s)
     local = test.times.tz_convert(timezone)
-    midnights = test.times[(local.hour == 0) & (local.minute == 0)]
+    day = local.normalize()
+    # A record whose rows are stamped off the hour (SYSLAB's at :11, :26, ...) has no row at
+    # midnight: each day starts at its row within one step after it.
+    starts = test.times[~day.duplicated() & ((local - day) < step)]
     horizon = pd.Timedelta(hours=horizon_h)
     errors, days = [], 0
-    for start in midnights:
-        if start + horizon > test.times[-1] + pd.Timedelta(seconds=test.step_s):
+    for start in starts:
+        if start + horizon > test.times[-1] + step:
             continue
         try:
             predicted = forecast(compiled, params, whole, start, horizon_h, history_h)
