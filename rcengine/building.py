@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -102,14 +103,20 @@ def _number(
     return float(value)
 
 
-def _timezone(name: object) -> str:
-    from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+@functools.cache
+def _zones() -> frozenset[str]:
+    from zoneinfo import available_timezones
 
-    try:
-        ZoneInfo(str(name))
-    except (ZoneInfoNotFoundError, ValueError) as exc:
-        raise BuildingError(f"field 'location.timezone': unknown time zone {name!r}") from exc
-    return str(name)
+    return frozenset(available_timezones())
+
+
+def _timezone(name: object) -> str:
+    """An IANA zone name. Only the database's zones (``zoneinfo.available_timezones``): a path
+    the loader would also open — a folder ("Europe"), "posixrules", "right/UTC" — is not a zone,
+    and a folder or an over-long name raised an OS error instead of this one."""
+    if not isinstance(name, str) or name == "localtime" or name not in _zones():
+        raise BuildingError(f"field 'location.timezone': unknown time zone {str(name)[:80]!r}")
+    return name
 
 
 def _surfaces(items: object, label: str) -> tuple[Surface, ...]:

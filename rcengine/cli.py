@@ -265,7 +265,9 @@ def diagnose(
     model: Annotated[str, typer.Option("--model", "-m", help="baseline model")] = "basic",
     json_out: Annotated[Path | None, typer.Option("--json", help="JSON report to write")] = None,
     html_out: Annotated[Path | None, typer.Option("--html", help="HTML report to write")] = None,
-    train_fraction: Annotated[float, typer.Option(help="share of the record fitted")] = 0.5,
+    train_fraction: Annotated[
+        float, typer.Option(help="share of the record fitted, 0.1 to 0.9")
+    ] = 0.5,
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
     save_model: Annotated[
         Path | None,
@@ -275,6 +277,13 @@ def diagnose(
     """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
     from rcengine.diagnose import DiagnoseSettings, selection
     from rcengine.diagnose.html import render
+    from rcengine.diagnose.settings import TRAIN_FRACTION
+
+    if not TRAIN_FRACTION[0] <= train_fraction <= TRAIN_FRACTION[1]:
+        raise typer.BadParameter(
+            f"{train_fraction:g} is outside [{TRAIN_FRACTION[0]}, {TRAIN_FRACTION[1]}]",
+            param_hint="--train-fraction",
+        )
 
     def run() -> None:
         b = Building.from_json(building)
@@ -291,7 +300,7 @@ def diagnose(
             f"final {d['final']['model']}: test RMSE {d['final']['rmse_test']:.3f} K "
             f"({report.wall_time_s:.1f} s)"
         )
-        ahead = d["day_ahead"]
+        ahead = d.get("day_ahead")
         if ahead and ahead["rmse_baseline"] is not None:
             typer.echo(
                 f"day-ahead forecast RMSE over the test half's {ahead['days']} days: "

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from sqlalchemy.orm import Session
 
 from rcengine.columns import T_IN, TIME
 from rcengine.dataset import Dataset
@@ -48,7 +49,8 @@ def from_json(body: bytes) -> Upload:
     """``{"rows": [{"time": ..., "t_in": ...}, ...]}``; problems name the index in ``rows``."""
     try:
         document = json.loads(body, parse_constant=_not_json)
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except (ValueError, UnicodeDecodeError) as exc:
+        # JSONDecodeError, and integers longer than Python converts (4,300 digits).
         where = f" at line {exc.lineno} column {exc.colno}" if hasattr(exc, "lineno") else ""
         raise _not_valid(f"{where}: {_reason(exc)}") from None
     except RecursionError:
@@ -91,28 +93,75 @@ def from_csv(body: bytes) -> Upload:
 def store(db: Database, building_id: int, upload: Upload) -> UploadResult:
     """Upsert the rows by time in one transaction; nothing is written if a check fails."""
     frame = upload.frame
+    _check_not_ahead(frame, upload.first_line)
     rows = bridge.frame_to_rows(frame)
     first, last = frame.index[0], frame.index[-1]
     with db.write() as session:
         building = repository.lock_building(session, building_id)
-        _check_grid(building, frame, upload.first_line)
+        step_s = _series_step_s(session, building, frame)
+        _check_grid(building, frame, step_s, upload.first_line)
         existing = repository.existing_times(
             session, building_id, bridge.to_datetime(first), bridge.to_datetime(last)
         )
         updated = len(existing.intersection(r[TIME] for r in rows))
         repository.upsert_measurements(session, building_id, list(frame.columns), rows)
-        _remember(building, frame)
+        _remember(building, frame, step_s)
         revision = repository.next_data_revision(session, building_id)
     return UploadResult(len(rows) - updated, updated, len(rows), first, last, revision)
+
+
+# How far a measured row may lie ahead of the server's clock: a device's clock may run minutes
+# fast; a measurement an hour or more ahead comes from a wrong clock or a local time sent as UTC.
+# Stored, such a row became the building's last measurement, every calibration then asked for
+# data up to it, and no upload could take it back.
+MAX_AHEAD = pd.Timedelta(hours=1)
+
+
+def _check_not_ahead(frame: pd.DataFrame, first_line: int | None) -> None:
+    """Measured t_in may not lie in the future; forecast rows (no t_in) may."""
+    now = pd.Timestamp.now(tz="UTC")
+    ahead = np.flatnonzero(frame[T_IN].notna().to_numpy() & (frame.index > now + MAX_AHEAD))
+    if not ahead.size:
+        return
+    line = "" if first_line is None else " — line {} of the file"
+    raise DataValidationError(
+        [
+            Problem(
+                int(row),
+                T_IN,
+                f"t_in measured at {frame.index[row].isoformat()}, after the server's clock "
+                f"({now:%Y-%m-%dT%H:%MZ}): check the device's clock and UTC offset; rows of the "
+                "future carry the forecast inputs with t_in empty"
+                + line.format(row + (first_line or 0)),
+            )
+            for row in ahead[:100]
+        ]
+    )
 
 
 def _upload_step_s(frame: pd.DataFrame) -> float | None:
     return Dataset.from_frame(frame).step_s if len(frame) >= 2 else None
 
 
-def _check_grid(building: BuildingRecord, frame: pd.DataFrame, first_line: int | None) -> None:
-    """Every time must be the stored grid origin plus a whole number of stored steps."""
-    step_s = building.step_s or _upload_step_s(frame)
+def _series_step_s(session: Session, building: BuildingRecord, frame: pd.DataFrame) -> float | None:
+    """The step of the building's series: the one stored, else this upload's, else — a device
+    that uploads one row at a time — the step of the rows stored before with this one (None
+    while the building holds a single time). Without it a streamed series took any time, its
+    steps mixed, and the building could never be calibrated (its step stayed unknown)."""
+    if building.step_s is not None:
+        return building.step_s
+    step_s = _upload_step_s(frame)
+    if step_s is not None or building.grid_origin is None:
+        return step_s
+    stored = pd.DatetimeIndex(repository.stored_times(session, building.id), tz="UTC")
+    times = stored.append(frame.index.tz_convert("UTC")).unique().sort_values()
+    return _upload_step_s(pd.DataFrame(index=times)) if len(times) >= 2 else None
+
+
+def _check_grid(
+    building: BuildingRecord, frame: pd.DataFrame, step_s: float | None, first_line: int | None
+) -> None:
+    """Every time must be the stored grid origin plus a whole number of the series' steps."""
     if building.grid_origin is None or step_s is None:
         return
     origin_ns = pd.Timestamp(building.grid_origin).as_unit("ns").value
@@ -139,8 +188,8 @@ def _check_grid(building: BuildingRecord, frame: pd.DataFrame, first_line: int |
     )
 
 
-def _remember(building: BuildingRecord, frame: pd.DataFrame) -> None:
-    """Grid of the series (first upload) and the latest measured time."""
+def _remember(building: BuildingRecord, frame: pd.DataFrame, step_s: float | None) -> None:
+    """Grid of the series (first upload), its step and the latest measured time."""
     measured = frame.index[frame[T_IN].notna().to_numpy()]
     if len(measured):
         latest = bridge.to_datetime(measured[-1])
@@ -149,7 +198,7 @@ def _remember(building: BuildingRecord, frame: pd.DataFrame) -> None:
     if building.grid_origin is None:
         building.grid_origin = bridge.to_datetime(frame.index[0])
     if building.step_s is None:
-        building.step_s = _upload_step_s(frame)
+        building.step_s = step_s
 
 
 def _reason(exc: Exception) -> str:

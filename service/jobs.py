@@ -420,6 +420,11 @@ def _measured_building(session: Session, building_id: int) -> BuildingRecord:
         raise ConflictError(
             f"building {building_id} has no measured t_in yet; upload measurements first"
         )
+    if building.step_s is None:
+        raise ConflictError(
+            f"building {building_id} holds a single time so far; its series' step is known "
+            "from two rows on: upload more measurements first"
+        )
     return building
 
 
@@ -488,6 +493,11 @@ def queue_retraining(
             queued.append(job.id)
         except ConflictError as exc:
             log.info("retraining skipped", extra={"building_id": building_id, "reason": str(exc)})
+        except (ServiceError, RCEngineError) as exc:
+            # One building's stored data must not stop the night for every other building.
+            log.warning(
+                "retraining not queued", extra={"building_id": building_id, "reason": str(exc)}
+            )
     return queued
 
 

@@ -159,6 +159,13 @@ def existing_times(
     return set(session.scalars(query))
 
 
+def stored_times(session: Session, building_id: int) -> list[datetime]:
+    """Every stored time of a building, in order (for a series whose step is not known yet)."""
+    time = measurements.c[TIME]
+    query = select(time).where(measurements.c.building_id == building_id).order_by(time)
+    return list(session.scalars(query))
+
+
 def upsert_measurements(
     session: Session, building_id: int, columns: Sequence[str], rows: list[dict[str, Any]]
 ) -> None:

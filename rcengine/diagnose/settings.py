@@ -80,10 +80,18 @@ class DiagnoseSettings:
         return FoldRule(self.min_fold_share, self.min_improvement)
 
 
+# The share of the record fitted: a tenth of it either side at least, or one half is too short
+# to fit or to test on.
+TRAIN_FRACTION = (0.1, 0.9)
+
+
 def split_time(frame: pd.DataFrame, fraction: float, timezone: str) -> pd.Timestamp:
     """Local midnight closest to ``fraction`` of the record, so train and test are whole days."""
-    if not 0.1 <= fraction <= 0.9:
-        raise ValueError(f"train_fraction must be within [0.1, 0.9], got {fraction}")
+    if not TRAIN_FRACTION[0] <= fraction <= TRAIN_FRACTION[1]:
+        raise ValueError(
+            f"train_fraction must be within [{TRAIN_FRACTION[0]}, {TRAIN_FRACTION[1]}], "
+            f"got {fraction}"
+        )
     t = frame.index[int(len(frame) * fraction)].tz_convert(timezone)
     midnight = t.normalize()
     if t - midnight > pd.Timedelta(hours=12):

@@ -6,8 +6,7 @@ or — where a building's time zone is given — a local date (``2017-01-09``, t
 or a local date-time without offset, read as the wall-clock time in that zone. A ``+`` turned
 into a space by URL decoding (``...T06:15:00 01:00``) is put back. Other spellings pandas would
 guess at (``now``, ``9/1/2017``) are refused; so are local times the clocks skip or repeat at a
-change of offset, and times outside pandas' nanosecond range (1677-09-21 … 2262-04-11), which
-would wrap.
+change of offset, and times outside ``SUPPORTED`` (1900-01-01 … 2199-12-31 UTC).
 """
 
 from __future__ import annotations
@@ -24,6 +23,14 @@ _PLUS_AS_SPACE = re.compile(rf"^({_DATE}[T ]{_TIME}) (\d{{2}}:?\d{{2}})$")
 # ISO 8601 extended form: a date, optionally a time, optionally a UTC offset.
 _ISO_8601 = re.compile(rf"^{_DATE}(?:[T ]{_TIME})?(?:Z|[+-]\d{{2}}(?::?\d{{2}})?)?$")
 _DATE_ONLY = re.compile(rf"^{_DATE}$")
+
+# Times a record, a forecast or a query may name, [start, end) in UTC. pandas holds instants in
+# nanoseconds, 1677-09-21 … 2262-04-11: a time accepted up to that edge overflowed later — a
+# row at 2262-04-11T23:45Z, stored, could not be shown in Europe/Rome's local time, and a forecast
+# start near either edge reached past it with the filter's 48 h look-back or a week's horizon.
+# No building's record lies near those edges; this range keeps every such step decades inside.
+SUPPORTED = (pd.Timestamp("1900-01-01", tz="UTC"), pd.Timestamp("2200-01-01", tz="UTC"))
+SUPPORTED_TEXT = "1900-01-01 … 2199-12-31"
 
 
 def parse_instant(value: object, name: str = "time", timezone: str | None = None) -> pd.Timestamp:
@@ -58,9 +65,12 @@ def parse_instant(value: object, name: str = "time", timezone: str | None = None
             raise _invalid(value, name, timezone, " (no UTC offset)")
         stamp = _localize(stamp, value, name, timezone)
     try:
-        return stamp.tz_convert("UTC").as_unit("ns")
+        utc = stamp.tz_convert("UTC").as_unit("ns")
     except (ValueError, OverflowError) as exc:
         raise _invalid(value, name, timezone, f" ({_reason(exc)})") from None
+    if not SUPPORTED[0] <= utc < SUPPORTED[1]:
+        raise _invalid(value, name, timezone, f" (outside the supported range {SUPPORTED_TEXT})")
+    return utc
 
 
 def is_local_date(value: object) -> bool:
@@ -95,7 +105,7 @@ def _localize(stamp: pd.Timestamp, value: object, name: str, timezone: str) -> p
 def _reason(exc: BaseException) -> str:
     text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     if "overflow" in text.lower() or "out of bounds" in text.lower():
-        return "outside the supported range 1677-09-22 … 2262-04-11"
+        return f"outside the supported range {SUPPORTED_TEXT}"
     if "tzoffset" in text:
         return "a UTC offset lies within ±24 h"
     # pandas ends some messages with the text parsed, already quoted in ours.

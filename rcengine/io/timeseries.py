@@ -52,6 +52,7 @@ from rcengine.columns import (
     TIME,
 )
 from rcengine.exceptions import DataValidationError, Problem
+from rcengine.io.instants import SUPPORTED, SUPPORTED_TEXT
 
 MAX_PROBLEMS = 1000
 # Data row 0 sits on line 2 of a CSV file, below the header.
@@ -70,7 +71,6 @@ _WITHOUT_OFFSET = re.compile(rf"^\s*{_LOCAL_TIME}\s*$")
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+\s*$")
 _NS_PER_S = 1_000_000_000
 _NAT = np.iinfo(np.int64).min  # NaT as int64 nanoseconds
-_NS_MIN, _NS_MAX = pd.Timestamp.min.tz_localize("UTC"), pd.Timestamp.max.tz_localize("UTC")
 
 
 @dataclass
@@ -275,23 +275,33 @@ def _parse_times(cells: pd.Series, problems: _Problems) -> tuple[np.ndarray, pd.
     cell texts for messages."""
     if isinstance(cells.dtype, pd.DatetimeTZDtype):
         ns = pd.DatetimeIndex(cells).as_unit("ns").asi8.copy()
+        text = cells.reset_index(drop=True).astype(str)
         problems.add_rows(np.flatnonzero(ns == _NAT), TIME, lambda r: "time is empty")
-        return ns, cells.reset_index(drop=True).astype(str)
-    text = _as_text(cells)
-    empty = text.isna().to_numpy()
-    ok = text.str.match(_WITH_OFFSET).fillna(False).to_numpy(dtype=bool)
+        bounds = [SUPPORTED[0].value, SUPPORTED[1].value]
+        outside = (ns != _NAT) & ((ns < bounds[0]) | (ns >= bounds[1]))
+        problems.add_rows(
+            np.flatnonzero(outside),
+            TIME,
+            lambda r: f"time {text[r]!r} is outside the supported range {SUPPORTED_TEXT}",
+        )
+        ns[outside] = _NAT
+        return ns, text
+    cell_text = _as_text(cells)
+    empty = cell_text.isna().to_numpy()
+    ok = cell_text.str.match(_WITH_OFFSET).fillna(False).to_numpy(dtype=bool)
     no_offset = np.zeros_like(ok)
     suspect = np.flatnonzero(~ok & ~empty)
-    no_offset[suspect] = text.iloc[suspect].str.match(_WITHOUT_OFFSET).to_numpy(dtype=bool)
+    no_offset[suspect] = cell_text.iloc[suspect].str.match(_WITHOUT_OFFSET).to_numpy(dtype=bool)
     parsed = pd.DatetimeIndex(
-        pd.to_datetime(text.where(ok), format="ISO8601", utc=True, errors="coerce")
+        pd.to_datetime(cell_text.where(ok), format="ISO8601", utc=True, errors="coerce")
     )
-    # pandas parses years 1–9999 at a coarser unit; nanoseconds reach 1677–2262 only.
-    outside = ok & ~np.asarray(parsed.isna() | ((parsed >= _NS_MIN) & (parsed <= _NS_MAX)))
+    text = cell_text.map(_shown)
+    # pandas parses years 1–9999 at a coarser unit (``instants.SUPPORTED`` says why the range).
+    outside = ok & ~np.asarray(parsed.isna() | ((parsed >= SUPPORTED[0]) & (parsed < SUPPORTED[1])))
     problems.add_rows(
         np.flatnonzero(outside),
         TIME,
-        lambda r: f"time {text[r]!r} is outside the supported range 1677-09-22 … 2262-04-11",
+        lambda r: f"time {text[r]!r} is outside the supported range {SUPPORTED_TEXT}",
     )
     ok = ok & ~outside
     ns = parsed.where(~outside).as_unit("ns").asi8.copy()
@@ -460,10 +470,27 @@ def _to_float(cells: pd.Series) -> np.ndarray:
     """Floats; NaN for blanks and for anything that is not a number (booleans included)."""
     if pd.api.types.is_bool_dtype(cells.dtype):
         return np.full(len(cells), np.nan)
+    if cells.dtype == object:
+        # A JSON integer past a float's range (400 digits) overflows pandas' conversion.
+        cells = cells.map(_float_if_int)
     numbers = pd.to_numeric(cells, errors="coerce")
     if cells.dtype == object:
         numbers = numbers.mask(cells.map(lambda v: isinstance(v, bool | np.bool_)).to_numpy())
     return numbers.to_numpy(dtype=float, na_value=np.nan)
+
+
+# The longest cell text a message quotes whole.
+SHOWN_CHARS = 64
+
+
+def _float_if_int(value: object) -> object:
+    """A Python int as a float (±inf past the float range, then refused as out of range)."""
+    if not isinstance(value, int) or isinstance(value, bool):
+        return value
+    try:
+        return float(value)
+    except OverflowError:
+        return float("inf") if value > 0 else float("-inf")
 
 
 def _blank(cells: pd.Series, numbers: np.ndarray) -> np.ndarray:
@@ -485,8 +512,12 @@ def _as_text(cells: pd.Series) -> pd.Series:
 
 
 def _shown(cell: object) -> object:
-    """A cell as its user wrote it: ``True``, not numpy's ``np.True_``."""
-    return cell.item() if isinstance(cell, np.generic) else cell
+    """A cell as its user wrote it — ``True``, not numpy's ``np.True_`` — and a long text cut:
+    a message quoting a 100 kB cell whole would send it back whole."""
+    cell = cell.item() if isinstance(cell, np.generic) else cell
+    if isinstance(cell, str) and len(cell) > SHOWN_CHARS:
+        return cell[: SHOWN_CHARS - 1] + "…"
+    return cell
 
 
 def _decimal_hint(cell: object) -> str:

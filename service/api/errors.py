@@ -12,7 +12,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from rcengine.exceptions import BuildingError, DataValidationError, ModelError
 
-from ..errors import ConflictError, NotFoundError
+from ..errors import CalibrationError, ConflictError, DiagnosisError, NotFoundError
 
 
 def _data_error(_request: Request, exc: Exception) -> JSONResponse:
@@ -84,5 +84,8 @@ def install_error_handlers(app: FastAPI) -> None:
         (ModelError, status.HTTP_422_UNPROCESSABLE_CONTENT),
         (NotFoundError, status.HTTP_404_NOT_FOUND),
         (ConflictError, status.HTTP_409_CONFLICT),
+        # The stored data do not allow the job asked for (too little, no step yet).
+        (CalibrationError, status.HTTP_409_CONFLICT),
+        (DiagnosisError, status.HTTP_409_CONFLICT),
     ):
         app.add_exception_handler(error, _answer(code))

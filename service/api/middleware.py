@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import re
 import time
 import uuid
 
@@ -13,9 +14,14 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 log = logging.getLogger("service.request")
 
 
+# A caller's request id is echoed and logged only if it looks like one (a UUID, a trace id): an
+# 8 kB header was sent back whole and written to every log line.
+_REQUEST_ID = re.compile(r"[A-Za-z0-9._:-]{1,128}")
+
+
 class RequestLogMiddleware:
     """One JSON log line per request (id, method, path, status, duration); the id is echoed in
-    the ``X-Request-ID`` response header (taken from the request's when it has one)."""
+    the ``X-Request-ID`` response header (taken from the request's when it has a plausible one)."""
 
     def __init__(self, app: ASGIApp):
         self.app = app
@@ -24,7 +30,8 @@ class RequestLogMiddleware:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        request_id = _header(scope, b"x-request-id") or uuid.uuid4().hex[:16]
+        given = _header(scope, b"x-request-id")
+        request_id = given if given and _REQUEST_ID.fullmatch(given) else uuid.uuid4().hex[:16]
         started = time.perf_counter()
         status_code = 500
 

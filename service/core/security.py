@@ -26,7 +26,9 @@ def hash_token(token: str) -> str:
 
 
 def same_hash(a: str, b: str) -> bool:
-    return hmac.compare_digest(a, b)
+    """Constant-time equality of two texts. As bytes: ``compare_digest`` refuses str with
+    non-ASCII characters (a TypeError, a 500, for a form field sent as "é")."""
+    return hmac.compare_digest(a.encode(), b.encode())
 
 
 def write_secret(path: Path, secret: str) -> None:

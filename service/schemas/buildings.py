@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field
+from typing import Annotated
+
+from pydantic import BaseModel, Field, Strict
 
 from .adoption import ModelInUse
 from .common import LocalTime, with_examples
@@ -41,16 +43,21 @@ READ_EXAMPLE = {
 }
 
 
+# A number of the description: a JSON number only. Lax parsing read `true` as 1 m² and "300" as
+# 300 m³; the engine, which also reads building files, refuses both.
+Number = Annotated[float, Strict()]
+
+
 class SurfaceIn(BaseModel):
-    azimuth: float = Field(description="Degrees clockwise from north (90 = east). [°]")
-    tilt: float = Field(description="Degrees from horizontal (90 = vertical). [°]")
-    area: float = Field(description="[m²]")
+    azimuth: Number = Field(description="Degrees clockwise from north (90 = east). [°]")
+    tilt: Number = Field(description="Degrees from horizontal (90 = vertical). [°]")
+    area: Number = Field(description="[m²]")
 
 
 class LocationIn(BaseModel):
-    latitude: float = Field(description="[°]")
-    longitude: float = Field(description="[°]")
-    altitude: float | None = Field(None, description="[m]")
+    latitude: Number = Field(description="[°]")
+    longitude: Number = Field(description="[°]")
+    altitude: Number | None = Field(None, description="[m]")
     timezone: str | None = Field(None, description="IANA name, e.g. Europe/Rome (default UTC)")
 
 
@@ -59,12 +66,13 @@ class BuildingCreate(BaseModel):
 
     model_config = with_examples(EXAMPLE)
 
-    name: str = Field("building", max_length=200)
+    # No control characters: PostgreSQL's text refuses NUL, and a name is shown in pages and logs.
+    name: str = Field("building", max_length=200, pattern=r"^[^\x00-\x1f\x7f]*$")
     location: LocationIn
-    floor_area: float = Field(description="[m²]")
-    volume: float = Field(description="[m³]")
-    wall_area: float = Field(description="[m²]")
-    internal_mass_area: float | None = Field(None, description="[m²]")
+    floor_area: Number = Field(description="[m²]")
+    volume: Number = Field(description="[m³]")
+    wall_area: Number = Field(description="[m²]")
+    internal_mass_area: Number | None = Field(None, description="[m²]")
     windows: list[SurfaceIn] = Field(default_factory=list)
     walls: list[SurfaceIn] = Field(default_factory=list)
 

@@ -8,6 +8,7 @@ from typing import Annotated, Any
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from rcengine.diagnose import DiagnoseSettings
+from rcengine.diagnose.settings import TRAIN_FRACTION
 
 from .common import LocalTime, ModelName, with_examples
 
@@ -94,8 +95,8 @@ class DiagnosisRequest(BaseModel):
     )
     train_fraction: float | None = Field(
         None,
-        gt=0.0,
-        lt=1.0,
+        ge=TRAIN_FRACTION[0],
+        le=TRAIN_FRACTION[1],
         description="Share of the window fitted (whole days); the rest tests the fit "
         "(default: the engine's, 0.5)",
     )

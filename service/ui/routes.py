@@ -17,6 +17,7 @@ from fastapi.responses import HTMLResponse, JSONResponse, RedirectResponse, Resp
 from fastapi.templating import Jinja2Templates
 
 from .. import repository
+from ..core.security import same_hash
 from ..diagnosis import DiagnosisSpec
 from ..errors import ConflictError, NotFoundError
 from ..models import CALIBRATION, DIAGNOSIS, JOB_COLLECTIONS
@@ -99,7 +100,7 @@ def login(
     csrf: Annotated[str, Form(max_length=100)] = "",
 ) -> Response:
     expected = request.cookies.get(SIGNIN_COOKIE, "")
-    if not expected or not secrets.compare_digest(expected, csrf):
+    if not expected or not same_hash(expected, csrf):
         return render(request, "login.html", 403, csrf="", error="the form expired; reload it")
     found = who(ctx, token) if token.strip() else None
     if found is None:

@@ -297,6 +297,14 @@ def test_large_building_description_is_413(client, settings):
         ({"floor_area": -5.0}, "floor_area"),
         ({"location": {"latitude": 95.0, "longitude": 7.0}}, "location.latitude"),
         ({"location": {"latitude": 45.0, "longitude": 7.0, "timezone": "Mars/Base"}}, "timezone"),
+        # A folder of the zone database and an over-long name raised OS errors (500s).
+        ({"location": {"latitude": 45.0, "longitude": 7.0, "timezone": "Europe"}}, "timezone"),
+        ({"location": {"latitude": 45.0, "longitude": 7.0, "timezone": "A" * 300}}, "timezone"),
+        ({"location": {"latitude": 45.0, "longitude": 7.0, "timezone": "posixrules"}}, "timezone"),
+        # Lax parsing read true as 1 m² and a text as a number.
+        ({"floor_area": True}, "floor_area"),
+        ({"volume": "300"}, "volume"),
+        ({"name": "office\x00"}, "name"),
         ({"windows": [{"azimuth": 90.0, "tilt": 200.0, "area": 4.0}]}, "windows[0].tilt"),
     ],
 )

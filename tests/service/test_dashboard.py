@@ -66,6 +66,8 @@ def test_sign_in_refuses_a_wrong_token_and_a_form_without_its_csrf_token(client)
     client.get("/ui/login")
     forged = client.post("/ui/login", data={"token": ADMIN_TOKEN, "csrf": "forged"})
     assert forged.status_code == 403
+    # Not ASCII: a str compare_digest raised TypeError (a 500) before the texts went as bytes.
+    assert client.post("/ui/login", data={"token": ADMIN_TOKEN, "csrf": "é"}).status_code == 403
     client.cookies.delete(SIGNIN_COOKIE, path="/ui")
     assert client.post("/ui/login", data={"token": ADMIN_TOKEN, "csrf": ""}).status_code == 403
     assert client.get("/ui/fleet", follow_redirects=False).status_code == 303
@@ -99,6 +101,7 @@ def test_forms_need_the_session_csrf_token(client, measured):
     jobs = client.get(f"/buildings/{building_id}/calibrations", headers=ADMIN).json()
     assert jobs["items"] == []
     assert client.post("/ui/logout", data={"csrf": "x"}).status_code == 403
+    assert client.post("/ui/logout", data={"csrf": "é"}).status_code == 403
 
 
 def test_building_page_shows_data_model_jobs_and_starts_a_calibration(client, measured):
