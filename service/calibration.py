@@ -37,7 +37,7 @@ from rcengine.estimation.estimator import POLISH_TOL, Estimator
 from rcengine.exceptions import ConvergenceWarning, RCEngineError
 from rcengine.forecast import forecast
 from rcengine.metrics import FitMetrics, evaluate
-from rcengine.models import get_model
+from rcengine.models import MODELS, get_model
 from rcengine.models.spec import ModelSpec, check_columns
 from rcengine.parameter_set import ParameterSet
 from rcengine.signals import SignalOptions, prepare
@@ -159,6 +159,12 @@ def load(db: Database, job: JobRecord, options: CalibrationOptions) -> Inputs:
         )
         frame = bridge.load_frame(session, job.building_id, window.train_start, window.end)
         current = repository.current_parameter_set(session, job.building_id)
+        adopted = _adopted(building_row.model_spec)
+        if adopted is None and job.model not in MODELS:
+            raise CalibrationError(
+                f"the adopted model {job.model} was reverted while this calibration waited; "
+                "nothing was fitted (the next calibration fits the building's base model)"
+            )
         return Inputs(
             bridge.building_of(building_row.description),
             job.model,
@@ -166,7 +172,7 @@ def load(db: Database, job: JobRecord, options: CalibrationOptions) -> Inputs:
             frame,
             None if current is None else bridge.parameter_set_of(current),
             None if current is None else current.id,
-            _adopted(building_row.model_spec),
+            adopted,
         )
 
 

@@ -172,7 +172,13 @@ def run_leased(
             details["duration_s"] = round(time.perf_counter() - started, 3)
             # Fenced: a run whose lease was taken over raises here, and what it saved rolls back.
             repository.finish_job(
-                session, job_id, SUCCEEDED, outcome=product.outcome, details=details, lease=lease
+                session,
+                job_id,
+                SUCCEEDED,
+                outcome=product.outcome,
+                details=details,
+                lease=lease,
+                model=details.get("model"),
             )
     log.info(
         "%s finished",

@@ -342,23 +342,27 @@ def finish_job(
     error: str | None = None,
     details: dict[str, Any] | None = None,
     lease: Lease | None = None,
+    model: str | None = None,
 ) -> None:
     """End a job; with ``lease``, only if that lease still holds it (LeaseLostError, and the
     caller's transaction must roll back, if not); without, only if it is still active. The
-    fencing token is incremented, so that no earlier lease can write again."""
+    fencing token is incremented, so that no earlier lease can write again. ``model``: the
+    model the job ended up fitting, where it differs from the one it was queued with (a
+    diagnosis adopted while it waited)."""
     query = update(JobRecord).where(JobRecord.id == job_id)
     query = _held(query, lease) if lease else query.where(JobRecord.status.in_(ACTIVE_JOB_STATUSES))
-    ended = session.execute(
-        query.values(
-            status=status,
-            outcome=outcome,
-            error=error,
-            details=details,
-            finished_at=utc_now(),
-            lease_token=JobRecord.lease_token + 1,
-            lease_expires_at=None,
-        )
-    )
+    values: dict[str, Any] = {
+        "status": status,
+        "outcome": outcome,
+        "error": error,
+        "details": details,
+        "finished_at": utc_now(),
+        "lease_token": JobRecord.lease_token + 1,
+        "lease_expires_at": None,
+    }
+    if model is not None:
+        values["model"] = model
+    ended = session.execute(query.values(**values))
     if ended.rowcount != 1:
         job = get_job(session, job_id)
         raise LeaseLostError(

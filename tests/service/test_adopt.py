@@ -381,3 +381,33 @@ def test_a_stored_model_this_engine_cannot_read_is_said_not_a_server_error(clien
     assert refused.status_code == 422 and "newer than this engine" in refused.json()["detail"]
     revert = client.post(f"/buildings/{building_id}/model/revert", headers=headers).json()
     assert revert["changed"] and revert["model_in_use"]["source"] == "base"
+
+
+def test_a_calibration_that_waited_through_a_revert_fails_saying_so(client, adopted):
+    """Queued for the adopted model, run after a revert: it said "invalid model
+    'basic+wind_infiltration'"; it now says the model was reverted and fits nothing."""
+    from types import SimpleNamespace
+
+    from service import calibration, repository
+    from service.errors import CalibrationError
+
+    building_id, headers, _, first = adopted
+    wait_for_job(client, first["calibration_job_id"], headers)
+    revert = client.post(f"/buildings/{building_id}/model/revert", headers=headers).json()
+    wait_for_job(client, revert["calibration_job_id"], headers)
+    db = client.app.state.context.db
+    waited = SimpleNamespace(building_id=building_id, model="basic+wind_infiltration", days=3)
+    with pytest.raises(CalibrationError, match="was reverted while this calibration waited"):
+        calibration.load(db, waited, calibration.CalibrationOptions())
+    # And a job records the model it fitted, whatever it was queued with.
+    job = client.post(f"/buildings/{building_id}/calibrations", json={}, headers=headers).json()
+    wait_for_job(client, job["id"], headers)
+    with db.write() as session:
+        repository.get_job(session, job["id"]).model = "queued-as"
+    with db.write() as session:
+        record = repository.get_job(session, job["id"])
+        record.status = "running"
+        record.lease_token = 0
+    with db.write() as session:
+        repository.finish_job(session, job["id"], "succeeded", details={}, model="basic")
+    assert client.get(f"/jobs/{job['id']}", headers=headers).json()["model"] == "basic"
