@@ -110,6 +110,34 @@ def store(db: Database, building_id: int, upload: Upload) -> UploadResult:
     return UploadResult(len(rows) - updated, updated, len(rows), first, last, revision)
 
 
+@dataclass(frozen=True)
+class RemovalResult:
+    deleted: int
+    last_measured_time: pd.Timestamp | None
+    data_revision: int
+
+
+def remove(db: Database, building_id: int, start: pd.Timestamp, end: pd.Timestamp) -> RemovalResult:
+    """Delete the rows with start ≤ time < end in one transaction: the way to take back rows a
+    device sent wrongly (a clock a year off), which an upload cannot (an empty value never
+    erases a stored one). The last measured time is read again; a building left with no rows
+    forgets its grid, so the next upload sets it anew."""
+    if end <= start:
+        raise DataValidationError([Problem(None, "end", "end must be after start")])
+    with db.write() as session:
+        building = repository.lock_building(session, building_id)
+        deleted = repository.delete_measurements(
+            session, building_id, bridge.to_datetime(start), bridge.to_datetime(end)
+        )
+        building.last_measured_at = repository.last_measured_time(session, building_id)
+        if not repository.building_summary(session, building_id).rows:
+            building.grid_origin = None
+            building.step_s = None
+        revision = repository.next_data_revision(session, building_id)
+        last = building.last_measured_at
+    return RemovalResult(deleted, None if last is None else pd.Timestamp(last), revision)
+
+
 # How far a measured row may lie ahead of the server's clock: a device's clock may run minutes
 # fast; a measurement an hour or more ahead comes from a wrong clock or a local time sent as UTC.
 # Stored, such a row became the building's last measurement, every calibration then asked for

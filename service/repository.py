@@ -12,12 +12,24 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta
 from typing import Any
 
-from sqlalchemy import Connection, Insert, Row, Select, String, and_, cast, func, select, update
+from sqlalchemy import (
+    Connection,
+    Insert,
+    Row,
+    Select,
+    String,
+    and_,
+    cast,
+    delete,
+    func,
+    select,
+    update,
+)
 from sqlalchemy.dialects import postgresql, sqlite
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from rcengine.columns import TIME
+from rcengine.columns import T_IN, TIME
 
 from .errors import ConflictError, LeaseLostError, NotFoundError
 from .models import (
@@ -164,6 +176,23 @@ def stored_times(session: Session, building_id: int) -> list[datetime]:
     time = measurements.c[TIME]
     query = select(time).where(measurements.c.building_id == building_id).order_by(time)
     return list(session.scalars(query))
+
+
+def delete_measurements(session: Session, building_id: int, start: datetime, end: datetime) -> int:
+    """Remove a building's rows with start ≤ time < end; returns how many."""
+    time = measurements.c[TIME]
+    query = delete(measurements).where(
+        measurements.c.building_id == building_id, time >= start, time < end
+    )
+    return session.execute(query).rowcount
+
+
+def last_measured_time(session: Session, building_id: int) -> datetime | None:
+    """The latest stored time with a measured t_in."""
+    query = select(func.max(measurements.c[TIME])).where(
+        measurements.c.building_id == building_id, measurements.c[T_IN].is_not(None)
+    )
+    return session.scalar(query)
 
 
 def upsert_measurements(

@@ -104,3 +104,18 @@ class MeasurementsRead(BaseModel):
     model_config = with_examples({"rows": EXAMPLE_ROWS})
 
     rows: list[dict[str, Any]]
+
+
+class RemovalResult(BaseModel):
+    """What a deletion of stored rows did."""
+
+    model_config = with_examples(
+        {"deleted": 96, "last_measured_time": "2017-01-09T23:45:00+01:00", "data_revision": 6},
+        from_attributes=True,
+    )
+
+    deleted: int = Field(description="Rows removed")
+    last_measured_time: LocalTime | None = Field(
+        description="The latest measured t_in still stored (null: none)"
+    )
+    data_revision: int

@@ -168,6 +168,14 @@ def register(
     return body["id"], bearer(body["token"])
 
 
+def assert_refused(response, field: str) -> None:
+    """422 in the documented shape: a text detail and problems naming ``field``."""
+    assert response.status_code == 422, response.text
+    body = response.json()
+    assert isinstance(body["detail"], str) and field in body["detail"]
+    assert any(p["column"] == field for p in body["problems"]), body
+
+
 def wait_for_job(client: TestClient | httpx.Client, job_id: int, headers: dict, timeout_s=60.0):
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:

@@ -14,7 +14,7 @@ from rcengine.io.timeseries import parse_rows
 from rcengine.parameter_set import ParameterSet
 from service import diagnosis
 
-from .conftest import ADMIN, DAY, SYNTHETIC_BUILDING, json_rows
+from .conftest import ADMIN, DAY, SYNTHETIC_BUILDING, assert_refused, json_rows, wait_for_job
 
 # API tests run on SQLite and on a real PostgreSQL server (conftest).
 ON_BOTH_DATABASES = True
@@ -25,14 +25,6 @@ ANCIENT = "0001-01-01T00:00:00+00:00"
 
 def summary(client, building_id, headers) -> dict:
     return client.get(f"/buildings/{building_id}", headers=headers).json()
-
-
-def assert_refused(response, field: str) -> None:
-    """422 in the documented shape: a text detail and problems naming ``field``."""
-    assert response.status_code == 422, response.text
-    body = response.json()
-    assert isinstance(body["detail"], str) and field in body["detail"]
-    assert any(p["column"] == field for p in body["problems"]), body
 
 
 # --- 1: ids beyond the database's integers ---------------------------------------------------
@@ -234,6 +226,8 @@ def test_diagnosis_job_keeps_the_days_asked_beside_the_days_used(client, measure
     assert response.status_code == 202, response.text
     job = response.json()
     assert job["days"] == 3 and job["options"]["days_requested"] == 56
+    # Let it end here, not in a pool the interpreter is shutting down.
+    wait_for_job(client, job["id"], headers, timeout_s=300.0)
 
 
 def test_a_building_file_given_as_parameters_says_what_it_is():

@@ -9,7 +9,7 @@ import pytest
 
 from service.jobs import queue_retraining
 
-from .conftest import json_rows, register
+from .conftest import assert_refused, json_rows, register, wait_for_job
 
 ON_BOTH_DATABASES = True
 
@@ -120,3 +120,47 @@ def test_a_train_fraction_the_engine_refuses_is_refused_with_the_request(client,
         )
         assert answer.status_code == 422, answer.text
         assert "train_fraction" in answer.text
+
+
+def test_a_stray_row_is_taken_back_and_the_building_calibrates_again(client, measured):
+    """A device a few years off: its row became the last measurement, every calibration then
+    planned its window up to 2020, and no upload could take the row back."""
+    building_id, headers = measured
+    url = f"/buildings/{building_id}/measurements"
+    before = summary(client, building_id, headers)
+    assert upload(client, building_id, headers, [row("2020-01-01T00:00:00Z")]).status_code == 200
+    assert summary(client, building_id, headers)["last_measured_time"].startswith("2020")
+    removed = client.delete(
+        url,
+        params={"start": "2019-12-31T00:00:00Z", "end": "2020-01-02T00:00:00Z"},
+        headers=headers,
+    )
+    assert removed.status_code == 200, removed.text
+    body = removed.json()
+    assert body["deleted"] == 1
+    assert body["last_measured_time"] == before["last_measured_time"]
+    after = summary(client, building_id, headers)
+    assert after["data_revision"] == before["data_revision"] + 2
+    job = client.post(f"/buildings/{building_id}/calibrations", json={"days": 1}, headers=headers)
+    assert wait_for_job(client, job.json()["id"], headers)["status"] == "succeeded"
+
+
+def test_deleting_every_row_forgets_the_grid_and_bounds_are_checked(client, measured):
+    building_id, headers = measured
+    url = f"/buildings/{building_id}/measurements"
+    inverted = client.delete(
+        url,
+        params={"start": "2017-01-10T00:00:00Z", "end": "2017-01-09T00:00:00Z"},
+        headers=headers,
+    )
+    assert_refused(inverted, "end")
+    missing = client.delete(url, params={"start": "2017-01-10T00:00:00Z"}, headers=headers)
+    assert missing.status_code == 422
+    everything = {"start": "1900-01-01T00:00:00Z", "end": "2199-12-31T00:00:00Z"}
+    assert client.delete(url, params=everything, headers=headers).json()["deleted"] == 4 * 96
+    emptied = summary(client, building_id, headers)
+    assert emptied["step_s"] is None and emptied["last_measured_time"] is None
+    # A new series on another grid is accepted: the old one is gone.
+    fresh = [row("2017-02-01T00:07:00Z"), row("2017-02-01T00:37:00Z")]
+    assert upload(client, building_id, headers, fresh).status_code == 200
+    assert summary(client, building_id, headers)["step_s"] == 1800.0

@@ -20,6 +20,7 @@ from ...schemas.common import error_responses, in_zone
 from ...schemas.measurements import (
     EXAMPLE_CSV,
     MeasurementsRead,
+    RemovalResult,
     UploadResult,
     upload_openapi,
 )
@@ -105,3 +106,27 @@ def read_measurements(
     for row, local in zip(rows, format_times(frame.index, tz), strict=True):
         row[TIME] = local
     return MeasurementsRead(rows=rows)
+
+
+@router.delete(
+    "/{building_id}/measurements",
+    summary="Delete the stored rows with start ≤ time < end",
+    description=(
+        "Takes back rows a device sent wrongly (a clock a year off, a test run): an upload "
+        "cannot, since an empty value never erases a stored one. Both bounds are required. The "
+        "building's last measured time is read again from what remains; the parameter sets "
+        "and reports are kept."
+    ),
+    responses=error_responses(401, 404, 422),
+)
+def delete_measurements(
+    building_id: BuildingDep,
+    ctx: ContextDep,
+    start: Annotated[str, TimeQuery],
+    end: Annotated[str, TimeQuery],
+) -> RemovalResult:
+    first, last = parse_instant(start, "start"), parse_instant(end, "end")
+    result = ingest.remove(ctx.db, building_id, first, last)
+    with ctx.db.session() as session:
+        tz = repository.get_building(session, building_id).timezone
+    return RemovalResult.model_validate(result, context=in_zone(tz))
