@@ -57,7 +57,9 @@ class Building:
             raise BuildingError("building description must be a JSON object")
         loc = data.get("location")
         if not isinstance(loc, dict):
-            raise BuildingError("field 'location' is required: {latitude, longitude, ...}")
+            raise BuildingError(
+                "field 'location' is required: {latitude, longitude, ...}", "location"
+            )
         location = Location(
             latitude=_number(loc, "latitude", "location.latitude", -90.0, 90.0),
             longitude=_number(loc, "longitude", "location.longitude", -180.0, 180.0),
@@ -93,13 +95,13 @@ def _number(
 ) -> float:
     if key not in obj or obj[key] is None:
         if default is None:
-            raise BuildingError(f"field '{label}' is required")
+            raise BuildingError(f"field '{label}' is required", label)
         return default
     value = obj[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise BuildingError(f"field '{label}' must be a number, got {value!r}")
+        raise BuildingError(f"field '{label}' must be a number, got {value!r}", label)
     if not lower <= value <= upper:
-        raise BuildingError(f"field '{label}' = {value} is outside [{lower}, {upper}]")
+        raise BuildingError(f"field '{label}' = {value} is outside [{lower}, {upper}]", label)
     return float(value)
 
 
@@ -115,17 +117,19 @@ def _timezone(name: object) -> str:
     the loader would also open — a folder ("Europe"), "posixrules", "right/UTC" — is not a zone,
     and a folder or an over-long name raised an OS error instead of this one."""
     if not isinstance(name, str) or name == "localtime" or name not in _zones():
-        raise BuildingError(f"field 'location.timezone': unknown time zone {str(name)[:80]!r}")
+        raise BuildingError(
+            f"field 'location.timezone': unknown time zone {str(name)[:80]!r}", "location.timezone"
+        )
     return name
 
 
 def _surfaces(items: object, label: str) -> tuple[Surface, ...]:
     if not isinstance(items, list):
-        raise BuildingError(f"field '{label}' must be a list of {{azimuth, tilt, area}}")
+        raise BuildingError(f"field '{label}' must be a list of {{azimuth, tilt, area}}", label)
     out = []
     for i, item in enumerate(items):
         if not isinstance(item, dict):
-            raise BuildingError(f"field '{label}[{i}]' must be an object")
+            raise BuildingError(f"field '{label}[{i}]' must be an object", f"{label}[{i}]")
         out.append(
             Surface(
                 azimuth=_number(item, "azimuth", f"{label}[{i}].azimuth", -360.0, 360.0) % 360.0,

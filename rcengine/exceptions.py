@@ -41,7 +41,12 @@ class DataValidationError(RCEngineError, ValueError):
 
 
 class BuildingError(RCEngineError, ValueError):
-    """The building description is invalid or lacks what a model needs."""
+    """The building description is invalid or lacks what a model needs; ``field``: the
+    description's field at fault (``location.timezone``, ``windows[0].tilt``), where one is."""
+
+    def __init__(self, message: str, field: str | None = None):
+        super().__init__(message)
+        self.field = field
 
 
 class ModelError(RCEngineError, ValueError):

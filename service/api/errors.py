@@ -53,7 +53,8 @@ def _field(location: tuple | list) -> str:
 def _answer(code: int):
     def handler(_request: Request, exc: Exception) -> JSONResponse:
         if code == status.HTTP_422_UNPROCESSABLE_CONTENT:  # documented with its problems
-            problem = {"row": None, "column": None, "message": str(exc)}
+            # A building description's field at fault is its "column" (docs/service.md).
+            problem = {"row": None, "column": getattr(exc, "field", None), "message": str(exc)}
             return JSONResponse({"detail": str(exc), "problems": [problem]}, code)
         return JSONResponse({"detail": str(exc)}, code)
 

@@ -312,4 +312,6 @@ def test_invalid_building_description_names_the_field(client, change, field):
     response = client.post("/buildings", json={**SYNTHETIC_BUILDING, **change}, headers=ADMIN)
     assert response.status_code == 422
     assert field in response.text
+    # The field is the problem's column, as for a request that fails the schema.
+    assert any(field in (p["column"] or "") for p in response.json()["problems"]), response.text
     assert client.get("/buildings", headers=ADMIN).json()["items"] == []
