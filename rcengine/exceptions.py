@@ -33,11 +33,18 @@ class DataValidationError(RCEngineError, ValueError):
 
     def __init__(self, problems: list[Problem], max_listed: int = 20):
         self.problems = list(problems)
+        self.max_listed = max_listed
         shown = "; ".join(str(p) for p in self.problems[:max_listed])
         more = len(self.problems) - max_listed
         if more > 0:
             shown += f"; ... and {more} more"
         super().__init__(f"invalid data: {shown}")
+
+    def __reduce__(self) -> tuple:
+        # Rebuilt from its problems, not its message: a job's error crosses to the service
+        # from a worker process, and the default (the message as ``problems``) listed each
+        # character of it as a problem.
+        return (type(self), (self.problems, self.max_listed))
 
 
 class BuildingError(RCEngineError, ValueError):
@@ -47,6 +54,9 @@ class BuildingError(RCEngineError, ValueError):
     def __init__(self, message: str, field: str | None = None):
         super().__init__(message)
         self.field = field
+
+    def __reduce__(self) -> tuple:
+        return (type(self), (str(self), self.field))
 
 
 class ModelError(RCEngineError, ValueError):

@@ -76,8 +76,10 @@ def job_model(spec: ModelSpec | None, default: str) -> str:
 
 def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> Change:
     """Make diagnosis ``diagnosis_id``'s final model the building's; NotFoundError for another
-    building's or an unknown diagnosis, ModelError when it has nothing to adopt."""
-    building = repository.get_building(session, building_id)
+    building's or an unknown diagnosis, ModelError when it has nothing to adopt. The building's
+    row is locked: two adoptions at once on PostgreSQL both read "not adopted" and both said
+    they changed the model."""
+    building = repository.lock_building(session, building_id)
     diagnosis = session.get(DiagnosisRecord, diagnosis_id)
     if diagnosis is None or diagnosis.building_id != building_id:
         raise NotFoundError(f"diagnosis {diagnosis_id} not found for building {building_id}")
@@ -100,8 +102,9 @@ def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> 
 
 
 def revert(session: Session, building_id: int, actor: str) -> Change:
-    """Back to the base model; the last base-model set served before is served again."""
-    building = repository.get_building(session, building_id)
+    """Back to the base model; the last base-model set served before is served again (the
+    building's row locked, as for ``adopt``)."""
+    building = repository.lock_building(session, building_id)
     if building.model_spec is None:
         return Change(_audit(session, building_id, REVERT, actor, None), None)
     building.model_spec = None

@@ -74,6 +74,26 @@ def load_frame(
     return rows_to_frame(rows, NUMERIC_COLUMNS)
 
 
+def whole_columns(frame: pd.DataFrame) -> tuple[pd.DataFrame, list[str]]:
+    """``frame`` without the optional columns that some of its rows lack, and a note for each.
+
+    Uploads may carry an optional column (q_occ, dni, wind_speed, ...) on some days and not on
+    others, and an upload cannot erase a value once stored. A model fed such a column meets
+    missing inputs; without it, the window is fitted on what every row has (the note says
+    so). Required columns stay: a row without them is refused at upload."""
+    partial = [
+        c
+        for c in frame.columns
+        if c in COLUMNS and not COLUMNS[c].required and frame[c].isna().any()
+    ]
+    notes = [
+        f"column '{c}' left out: missing in {int(frame[c].isna().sum())} of {len(frame)} rows "
+        f"of the window ({frame.index[frame[c].isna().to_numpy()][0].isoformat()} first)"
+        for c in partial
+    ]
+    return frame.drop(columns=partial), notes
+
+
 # --- buildings and parameter sets -------------------------------------------------------------
 def building_of(description: dict[str, Any]) -> Building:
     return Building.from_dict(description)

@@ -80,9 +80,10 @@ class Window:
         }
 
 
-@dataclass(frozen=True)
+@dataclass
 class Calibrated:
-    """A fitted set, its and the current set's held-out metrics, and the decision."""
+    """A fitted set, its and the current set's held-out metrics, and the decision (final once
+    :meth:`save` has checked the building's model in the same transaction)."""
 
     parameter_set: ParameterSet
     window: Window
@@ -100,7 +101,18 @@ class Calibrated:
 
     def save(self, session: Session, job: JobRecord) -> dict[str, Any]:
         """Store the set (current if promoted, else rejected with its reason); the job's
-        details."""
+        details. A set of a model the building no longer uses — adopted or reverted while the
+        job ran — is stored rejected: promoted, a reverted model was served on, and every later
+        base-model fit lost the held-out day to it."""
+        building = repository.lock_building(session, job.building_id)
+        in_use = _adopted(building.model_spec)
+        fitted = self.parameter_set.model
+        if (in_use is not None and fitted != in_use.name) or (
+            in_use is None and fitted not in MODELS
+        ):
+            now = in_use.name if in_use is not None else "the base model"
+            self.promote = False
+            self.reason = f"the building's model changed to {now} while this calibration ran"
         record = repository.add_parameter_set(
             session,
             bridge.parameter_set_record(
@@ -179,7 +191,7 @@ def load(db: Database, job: JobRecord, options: CalibrationOptions) -> Inputs:
 def compute(inputs: Inputs, options: CalibrationOptions) -> Calibrated:
     """The fit, both held-out scores and the gate on :func:`load`'s inputs (no database)."""
     frame, window = inputs.frame, inputs.window
-    training = frame.loc[frame.index < window.holdout_start]
+    training, left_out = bridge.whole_columns(frame.loc[frame.index < window.holdout_start])
     _check_enough(training, window)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConvergenceWarning)
@@ -200,7 +212,7 @@ def compute(inputs: Inputs, options: CalibrationOptions) -> Calibrated:
         inputs.current_id,
         better and gate.passed,
         gate.reason() if not gate.passed else note or _verdict(new_score, current_score),
-        [str(w.message) for w in caught],
+        [*left_out, *(str(w.message) for w in caught)],
         gate,
     )
 

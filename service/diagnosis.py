@@ -169,7 +169,7 @@ class Inputs:
     model: str
     plan: DiagnosisPlan
     building: Building
-    step_s: float
+    step_s: float | None  # None: every row deleted since the job was queued
     frame: pd.DataFrame
 
 
@@ -193,6 +193,7 @@ def compute(inputs: Inputs, options: DiagnosisOptions) -> Diagnosed:
     job_plan, frame, step_s = inputs.plan, inputs.frame, inputs.step_s
     _check_enough(frame, job_plan, step_s)
     settings = engine_settings(job_plan, options)
+    frame, left_out = bridge.whole_columns(frame)
     context = {"job_id": inputs.job_id, "building_id": inputs.building_id}
     report, page = diagnose_frame(
         frame,
@@ -211,6 +212,7 @@ def compute(inputs: Inputs, options: DiagnosisOptions) -> Diagnosed:
             "random_state": settings.random_state,
             "train_fraction": settings.train_fraction,
             "effects": list(settings.effects),
+            "columns_left_out": left_out,
         },
         report=report,
         html=page,
@@ -248,9 +250,11 @@ def diagnose_frame(
     return json.loads(report.to_json()), render(report)
 
 
-def _check_enough(frame: pd.DataFrame, job_plan: DiagnosisPlan, step_s: float) -> None:
+def _check_enough(frame: pd.DataFrame, job_plan: DiagnosisPlan, step_s: float | None) -> None:
+    """Enough measured rows in the window; ``step_s`` None: the rows were deleted after the
+    job was queued (the building forgot its grid)."""
     measured = int(frame[T_IN].notna().sum()) if T_IN in frame else 0
-    if measured * step_s < MIN_DIAGNOSIS_DAYS * 86400.0:
+    if step_s is None or measured * step_s < MIN_DIAGNOSIS_DAYS * 86400.0:
         raise DiagnosisError(
             f"not enough measured data: a diagnosis needs at least {MIN_DIAGNOSIS_DAYS} days of "
             f"measured t_in (whole days to fit, whole days to test); found {measured} row(s) "

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from sqlalchemy.orm import Session
 
-from rcengine.columns import T_IN, TIME
+from rcengine.columns import MAX_STEP_S, MIN_STEP_S, T_IN, TIME
 from rcengine.dataset import Dataset
 from rcengine.exceptions import DataValidationError, Problem
 from rcengine.io.timeseries import FIRST_DATA_LINE, format_times, parse_rows, read_timeseries
@@ -183,7 +183,11 @@ def _series_step_s(session: Session, building: BuildingRecord, frame: pd.DataFra
         return step_s
     stored = pd.DatetimeIndex(repository.stored_times(session, building.id), tz="UTC")
     times = stored.append(frame.index.tz_convert("UTC")).unique().sort_values()
-    return _upload_step_s(pd.DataFrame(index=times)) if len(times) >= 2 else None
+    # Only an interval the contract allows as a step can be one: two rows two days apart are a
+    # gap (the step stayed 190,800 s, and every later row was off that grid).
+    seconds = np.diff(times.as_unit("ns").asi8) / _NS_PER_S
+    steps = seconds[(seconds >= MIN_STEP_S) & (seconds <= MAX_STEP_S)]
+    return float(pd.Series(steps).mode().min()) if steps.size else None
 
 
 def _check_grid(

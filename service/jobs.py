@@ -428,8 +428,8 @@ def _measured_building(session: Session, building_id: int) -> BuildingRecord:
         )
     if building.step_s is None:
         raise ConflictError(
-            f"building {building_id} holds a single time so far; its series' step is known "
-            "from two rows on: upload more measurements first"
+            f"building {building_id} has no time step yet: it is known once two stored rows "
+            "lie 60–3600 s apart; upload more measurements first"
         )
     return building
 

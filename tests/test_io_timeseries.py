@@ -332,3 +332,17 @@ def test_write_then_read_gives_the_same_frame():
     assert buffer.getvalue().splitlines()[1].startswith("2017-01-09T06:00:00+01:00,")
     back = read_timeseries(io.StringIO(buffer.getvalue()))
     pd.testing.assert_frame_equal(back, frame)
+
+
+def test_errors_cross_a_process_boundary_whole():
+    """A job's error is pickled back from its worker: it listed each character of its message
+    as a problem."""
+    import pickle
+
+    from rcengine.exceptions import BuildingError, DataValidationError, Problem
+
+    error = DataValidationError([Problem(96, "q_occ", "input value missing")] * 25)
+    back = pickle.loads(pickle.dumps(error))
+    assert str(back) == str(error) and back.problems == error.problems
+    building = pickle.loads(pickle.dumps(BuildingError("field 'volume' ...", "volume")))
+    assert (str(building), building.field) == ("field 'volume' ...", "volume")

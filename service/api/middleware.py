@@ -56,7 +56,8 @@ class RequestLogMiddleware:
                 "duration_ms": round((time.perf_counter() - started) * 1000.0, 2),
             }
             building_id = str(scope.get("path_params", {}).get("building_id", ""))
-            if building_id.isdigit():
+            # An id the database can hold (a 5,000-digit one exceeds int()'s digit limit).
+            if building_id.isdigit() and len(building_id) <= 18:
                 extra["building_id"] = int(building_id)
             log.info("request", extra=extra)
 

@@ -411,3 +411,36 @@ def test_a_calibration_that_waited_through_a_revert_fails_saying_so(client, adop
     with db.write() as session:
         repository.finish_job(session, job["id"], "succeeded", details={}, model="basic")
     assert client.get(f"/jobs/{job['id']}", headers=headers).json()["model"] == "basic"
+
+
+def test_a_set_of_a_model_reverted_while_it_was_fitted_is_not_served(client, adopted):
+    """Reverted while the adopted model's calibration ran: that set was promoted, the reverted
+    model was served on, and every later base-model fit lost the held-out day to it."""
+    from types import SimpleNamespace
+
+    from service import calibration
+
+    building_id, headers, diagnosis_id, first = adopted
+    wait_for_job(client, first["calibration_job_id"], headers)
+    # The module's building may have been reverted by an earlier test: adopt (again).
+    url = f"/buildings/{building_id}/diagnoses/{diagnosis_id}/adopt"
+    again = client.post(url, headers=headers).json()
+    if again["calibration_job_id"] is not None:
+        wait_for_job(client, again["calibration_job_id"], headers)
+    done = wait_for_job(client, first["calibration_job_id"], headers)
+    db = client.app.state.context.db
+    options = calibration.CalibrationOptions(preset="modestpy")
+    running = SimpleNamespace(id=done["id"], building_id=building_id, days=3, model=done["model"])
+    product = calibration.compute(calibration.load(db, running, options), options)
+    revert = client.post(f"/buildings/{building_id}/model/revert", headers=headers).json()
+    wait_for_job(client, revert["calibration_job_id"], headers)
+    served = client.get(f"/buildings/{building_id}", headers=headers).json()
+    with db.write() as session:
+        details = product.save(session, running)
+    assert product.outcome == "rejected"
+    assert details["reason"] == (
+        "the building's model changed to the base model while this calibration ran"
+    )
+    after = client.get(f"/buildings/{building_id}", headers=headers).json()
+    assert after["current_parameter_set_id"] == served["current_parameter_set_id"]
+    assert forecast(client, building_id, headers).json()["parameter_set"]["model"] == "basic"

@@ -6,6 +6,7 @@ import io
 from collections.abc import Callable
 from typing import Annotated
 
+import pandas as pd
 from fastapi import APIRouter, HTTPException, Query, Request, status
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
@@ -72,6 +73,12 @@ def _parse_and_store(
         return result, repository.get_building(session, building_id).timezone
 
 
+def _bound(value: str, name: str) -> pd.Timestamp:
+    """A period's bound at the database's microseconds, rounded up: truncated, a start a
+    nanosecond after a row's time took that row in (start ≤ time < end)."""
+    return parse_instant(value, name).ceil("us")
+
+
 TimeQuery = Query(description="ISO 8601 with offset", examples=["2017-01-09T00:00:00+01:00"])
 
 
@@ -93,8 +100,8 @@ def read_measurements(
         str, Query(alias="format", pattern="^(json|csv)$", examples=["json"])
     ] = "json",
 ):
-    first = None if start is None else parse_instant(start, "start")
-    last = None if end is None else parse_instant(end, "end")
+    first = None if start is None else _bound(start, "start")
+    last = None if end is None else _bound(end, "end")
     with ctx.db.session() as session:
         tz = repository.get_building(session, building_id).timezone
         frame = bridge.load_frame(session, building_id, first, last)
@@ -125,7 +132,7 @@ def delete_measurements(
     start: Annotated[str, TimeQuery],
     end: Annotated[str, TimeQuery],
 ) -> RemovalResult:
-    first, last = parse_instant(start, "start"), parse_instant(end, "end")
+    first, last = _bound(start, "start"), _bound(end, "end")
     result = ingest.remove(ctx.db, building_id, first, last)
     with ctx.db.session() as session:
         tz = repository.get_building(session, building_id).timezone
