@@ -17,8 +17,12 @@ building's time zone (``rcengine.io.instants``). Engine errors and bad values en
 
 from __future__ import annotations
 
+import io
 import json
+import math
+import os
 import sys
+import tempfile
 import warnings
 from collections.abc import Callable
 from dataclasses import replace
@@ -36,12 +40,14 @@ from rcengine.estimation.likelihood import LikelihoodFit
 from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
 from rcengine.forecast import forecast_frame
 from rcengine.io.instants import parse_instant
+from rcengine.io.jsonable import write_text_atomic
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
 from rcengine.models.spec import ModelSpec, check_columns
 from rcengine.network import RCNetwork
 from rcengine.parameter_set import ParameterSet
 from rcengine.signals import SignalOptions, prepare
+from rcengine.signals.solar import SKY_MODELS
 from rcengine.statespace import HOLDS
 
 app = typer.Typer(
@@ -55,6 +61,10 @@ BuildingOpt = Annotated[
     Path, typer.Option("--building", "-b", help="building JSON (CONTRACT.md §2)", exists=True)
 ]
 WHEN = "ISO 8601 with UTC offset, or a local date in the building's time zone"
+# The longest forecast a command computes: a (leap) year. [h]
+MAX_HORIZON_H = 8784.0
+# Worker processes a study may start: more only queue, and 100,000 hung the machine.
+MAX_WORKERS = 256
 
 
 def fail(message: str) -> NoReturn:
@@ -71,11 +81,37 @@ def _check(check: Callable[[str], object], value: str) -> None:
 
 
 def _run(fn):
-    """Turn the engine's own errors into a one-line message and exit code 2."""
+    """Turn the engine's own errors, and a file that cannot be read or written (a full disk),
+    into a one-line message and exit code 2."""
     try:
         return fn()
     except RCEngineError as exc:
         fail(str(exc))
+    except OSError as exc:
+        fail(f"{exc.filename or 'a file'}: {exc.strerror or exc}")
+
+
+def _output(path: Path | None, option: str, *inputs: Path | None) -> None:
+    """Refuse, before any work, an output that cannot be written or would replace an input:
+    found only after a whole fit, a bad path ended in a traceback."""
+    if path is None:
+        return
+    target = path.resolve()
+    if any(i is not None and i.resolve() == target for i in inputs):
+        fail(f"{option} {path} is also an input; write the result to another file")
+    if target.is_dir():
+        fail(f"{option} {path} is a directory; give a file name")
+    parent = target.parent
+    if not parent.is_dir():
+        fail(f"{option} {path}: the folder {parent} does not exist")
+    # A file created where the result will be renamed in (``write_text_atomic``): permission
+    # bits say nothing of /proc or a read-only mount.
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", dir=parent)
+    except OSError as exc:
+        fail(f"{option} {path}: cannot write there ({exc.strerror or exc})")
+    os.close(fd)
+    os.unlink(probe)
 
 
 def _instant(value: str | None, option: str, timezone: str) -> pd.Timestamp | None:
@@ -108,13 +144,17 @@ def fit(
     ] = None,
     model_file: Annotated[
         Path | None,
-        typer.Option(help="model specification (`rcengine diagnose --save-model`) instead of -m"),
+        typer.Option(
+            help="model specification (`rcengine diagnose --save-model`) instead of -m",
+            exists=True,
+            dir_okay=False,
+        ),
     ] = None,
     start: Annotated[str | None, typer.Option(help=f"first time fitted: {WHEN}")] = None,
     end: Annotated[str | None, typer.Option(help=f"end of the fit (exclusive): {WHEN}")] = None,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "thorough",
     weekdays: Annotated[bool, typer.Option(help="fit Monday–Friday only")] = False,
-    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    seed: Annotated[int, typer.Option(help="random seed", min=0)] = 0,
     sky_model: Annotated[str, typer.Option(help="isotropic | perez | haydavies")] = "isotropic",
     criterion: Annotated[
         str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
@@ -130,10 +170,14 @@ def fit(
     """Calibrate MODEL (or the model of --model-file) on DATA and write the parameter set."""
 
     _check(check_criterion, criterion)
+    _check(settings_for, preset)
     if input_hold not in HOLDS:
         fail(f"--input-hold must be one of {' | '.join(HOLDS)}, not {input_hold!r}")
+    if sky_model not in SKY_MODELS:
+        fail(f"--sky-model must be one of {' | '.join(SKY_MODELS)}, not {sky_model!r}")
     if (model is None) == (model_file is None):
         fail("give either --model or --model-file")
+    _output(output, "-o", data, building, model_file)
 
     def run() -> None:
         b = Building.from_json(building)
@@ -224,6 +268,9 @@ def predict(
     ] = False,
 ) -> None:
     """Forecast indoor temperature from START for HOURS; writes time,t_in_pred[,t_in_std]."""
+    if not math.isfinite(hours) or hours > MAX_HORIZON_H:
+        fail(f"--hours must be a finite horizon of at most {MAX_HORIZON_H} h, not {hours:g}")
+    _output(output, "-o", data, params)
 
     def run() -> None:
         pset = ParameterSet.load(params)
@@ -233,7 +280,9 @@ def predict(
             pset.compiled, pset.values, frame, pset.prepare, first, hours, noise=pset.noise
         )
         frame = fc.to_frame(std)
-        write_timeseries(frame, output, pset.building.location.timezone)
+        text = io.StringIO()
+        write_timeseries(frame, text, pset.building.location.timezone)
+        write_text_atomic(output, text.getvalue())
         nominal = "" if pset.noise else " (nominal: no fitted noise model)"
         typer.echo(
             f"forecast {len(frame)} steps from {frame.index[0]}: t_in_pred "
@@ -268,7 +317,7 @@ def diagnose(
     train_fraction: Annotated[
         float, typer.Option(help="share of the record fitted, 0.1 to 0.9")
     ] = 0.5,
-    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    seed: Annotated[int, typer.Option(help="random seed", min=0)] = 0,
     save_model: Annotated[
         Path | None,
         typer.Option(help="write the final model's specification (for `fit --model-file`)"),
@@ -284,6 +333,12 @@ def diagnose(
             f"{train_fraction:g} is outside [{TRAIN_FRACTION[0]}, {TRAIN_FRACTION[1]}]",
             param_hint="--train-fraction",
         )
+    outputs = {"--json": json_out, "--html": html_out, "--save-model": save_model}
+    for option, path in outputs.items():
+        _output(path, option, data, building)
+    given = [p.resolve() for p in outputs.values() if p is not None]
+    if len(set(given)) < len(given):
+        fail("--json, --html and --save-model must name different files")
 
     def run() -> None:
         b = Building.from_json(building)
@@ -307,10 +362,10 @@ def diagnose(
                 f"{ahead['rmse_baseline']:.3f} K (baseline) → {ahead['rmse_final']:.3f} K (final)"
             )
         if json_out:
-            json_out.write_text(report.to_json() + "\n")
+            write_text_atomic(json_out, report.to_json() + "\n")
             typer.echo(f"wrote {json_out}")
         if html_out:
-            html_out.write_text(render(report))
+            write_text_atomic(html_out, render(report))
             typer.echo(f"wrote {html_out}")
         if save_model:
             _save_model(d, b, frame, model, save_model)
@@ -345,15 +400,16 @@ def study(
     models: Annotated[str, typer.Option(help="comma-separated model names")] = "basic,sun",
     start: Annotated[str | None, typer.Option(help=f"first predicted day: {WHEN}")] = None,
     end: Annotated[str | None, typer.Option(help=f"end of the predicted days: {WHEN}")] = None,
-    workers: Annotated[int, typer.Option(help="processes (0: every core)")] = 0,
+    workers: Annotated[
+        int, typer.Option(help="processes (0: every core)", min=0, max=MAX_WORKERS)
+    ] = 0,
     preset: Annotated[str, typer.Option(help=f"estimator preset: {sorted(PRESETS)}")] = "study",
-    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    seed: Annotated[int, typer.Option(help="random seed", min=0)] = 0,
     criterion: Annotated[
         str, typer.Option(help=f"estimation criterion: {' | '.join(CRITERIA)}")
     ] = "output_error",
 ) -> None:
     """The thesis's rolling learn/predict study: tables, summary.json and figures."""
-    import os
     import time
 
     from rcengine.study.report import write_study
@@ -361,14 +417,23 @@ def study(
 
     _check(settings_for, preset)
     _check(check_criterion, criterion)
+    names = tuple(m.strip() for m in models.split(",") if m.strip())
+    if not names:
+        fail("--models names no model; e.g. --models basic,sun")
+    if output.exists() and not output.is_dir():
+        fail(f"-o {output} is a file; give a folder for the tables and figures")
+    if not output.resolve().parent.is_dir() or not os.access(output.resolve().parent, os.W_OK):
+        fail(f"-o {output}: its parent folder does not exist or is not writable")
 
     def run() -> None:
         started = time.perf_counter()
         b = Building.from_json(building)
         first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
+        # Read before the study, not after it: a bad file found then cost the whole run.
+        free = read_timeseries(freefloat) if freefloat else None
         settings = StudySettings(
-            models=tuple(m.strip() for m in models.split(",") if m.strip()),
+            models=names,
             preset=preset,
             start=first,
             end=last,
@@ -378,8 +443,12 @@ def study(
         )
         with progress_bar() as progress:
             results = run_study(frame, b, settings, progress)
+        if results.empty:
+            fail(
+                "no day was predicted: the record (and --start/--end) leave no day with the "
+                "training days before it"
+            )
         typer.echo("writing tables, figures and the free-floating validation …")
-        free = read_timeseries(freefloat) if freefloat else None
         written = write_study(results, settings, frame, b, free, output)
         typer.echo(
             f"{len(results)} trainings in {time.perf_counter() - started:.0f} s; "

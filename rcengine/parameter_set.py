@@ -21,7 +21,7 @@ from rcengine.building import Building
 from rcengine.dataset import Dataset
 from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ModelError
-from rcengine.io.jsonable import jsonable, read_json
+from rcengine.io.jsonable import jsonable, read_json, write_text_atomic
 from rcengine.kalman import Noise
 from rcengine.metrics import evaluate
 from rcengine.network import CompiledNetwork, RCNetwork
@@ -144,6 +144,8 @@ class ParameterSet:
     def from_dict(cls, data: dict[str, Any]) -> ParameterSet:
         try:
             network = RCNetwork.from_dict(data["network"])
+            if not isinstance(data["parameters"], dict):
+                raise TypeError("'parameters' must be an object {name: {value, ...}}")
             values = {name: float(p["value"]) for name, p in data["parameters"].items()}
             return cls(
                 model=data["model"],
@@ -162,7 +164,7 @@ class ParameterSet:
             raise ModelError(f"invalid parameter file: {exc}") from exc
 
     def save(self, path: str | Path) -> None:
-        Path(path).write_text(json.dumps(jsonable(self.to_dict()), indent=2) + "\n")
+        write_text_atomic(path, json.dumps(jsonable(self.to_dict()), indent=2) + "\n")
 
     @classmethod
     def load(cls, path: str | Path) -> ParameterSet:

@@ -267,7 +267,7 @@ def test_study_reads_instants_and_local_dates_alike(workdir, monkeypatch, form):
 
     def run_study(frame, building, settings, progress):
         seen["settings"] = settings
-        return pd.DataFrame()
+        return pd.DataFrame({"day": [0]})  # one day predicted
 
     monkeypatch.setattr(rcengine.study.run, "run_study", run_study)
     monkeypatch.setattr(rcengine.study.report, "write_study", lambda *args: [])
@@ -288,7 +288,7 @@ def test_study_passes_the_criterion(workdir, monkeypatch, criterion):
     import rcengine.study.report
     import rcengine.study.run
 
-    seen, frame = {}, pd.DataFrame()
+    seen, frame = {}, pd.DataFrame({"day": [0]})
     monkeypatch.setattr(
         rcengine.study.run, "run_study", lambda *args: seen.setdefault("s", args[2]) and frame
     )
@@ -340,3 +340,70 @@ def test_bad_date_option_is_named(workdir, office_fit, bad, option):
 def test_start_not_before_end_is_refused(workdir, end):
     for args in date_commands(OFFICE_FIT[0], end).values():
         assert_refused(invoke(*args), f"--start {OFFICE_FIT[0]!r} is not before --end {end!r}")
+
+
+# --- found by probing the CLI (nineteenth session): each was a traceback ------------------------
+FIT = ["fit", "data.csv", "--building", "b.json", "--model", "basic"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["fit", "data.csv", "--building", "adir", "-m", "basic", "-o", "p.json"], "cannot read"),
+        (["fit", "data.csv", "--building", "bin.json", "-m", "basic", "-o", "p.json"], "not UTF-8"),
+        ([*FIT, "--preset", "nosuch", "-o", "p.json"], "invalid preset 'nosuch'"),
+        ([*FIT, "--sky-model", "nosuch", "-o", "p.json"], "--sky-model must be one of"),
+        ([*FIT, "-o", "nowhere/p.json"], "does not exist"),
+        ([*FIT, "-o", "adir"], "is a directory"),
+        ([*FIT, "-o", "/proc/p.json"], "cannot write there"),
+        ([*FIT, "-o", "b.json"], "is also an input"),
+        (["study", "data.csv", "--building", "b.json", "--models", ",", "-o", "out"], "no model"),
+    ],
+)
+def test_bad_files_and_options_are_one_line_before_any_work(workdir, args, message):
+    Path("adir").mkdir()
+    Path("bin.json").write_bytes(bytes(range(128, 256)))
+    before = Path("b.json").read_text()
+    result = invoke(*args)
+    assert_refused(result, message)
+    assert Path("b.json").read_text() == before
+
+
+@pytest.mark.parametrize("hours", ["nan", "inf", "1e9"])
+def test_a_horizon_that_is_no_number_of_hours_is_refused(workdir, office_fit, hours):
+    Path("params.json").write_text(office_fit["path"].read_text())
+    result = invoke(
+        "predict", "data.csv", "--params", "params.json", "--start", OFFICE_FORECAST_START,
+        "--hours", hours, "-o", "f.csv",
+    )  # fmt: skip
+    assert_refused(result, "--hours must be a finite horizon")
+
+
+def test_a_result_is_written_whole_or_the_old_file_stays(workdir, office_fit, monkeypatch):
+    """Written in place, a failure mid-write (a full disk) left half a file where the previous
+    good one had been."""
+    import os
+
+    Path("p.json").write_text('{"previous": true}\n')
+
+    class FullDisk:
+        def __init__(self, handle):
+            self.handle = handle
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.handle.close()
+
+        def write(self, text):
+            self.handle.write(text[:100])
+            raise OSError(28, "No space left on device")
+
+    real_fdopen = os.fdopen
+    monkeypatch.setattr(os, "fdopen", lambda fd, *a, **k: FullDisk(real_fdopen(fd, *a, **k)))
+    window = ["--start", OFFICE_FIT[0], "--end", OFFICE_FIT[1], "--preset", "default"]
+    result = invoke(*FIT, *window, "-o", "p.json")
+    assert result.exit_code == 2 and "No space left on device" in result.output
+    assert Path("p.json").read_text() == '{"previous": true}\n'
+    assert [p.name for p in Path().iterdir() if p.name.startswith(".p.json")] == []

@@ -38,7 +38,7 @@ from rcengine.columns import (
     T_OUT,
 )
 from rcengine.exceptions import DataValidationError, ModelError, Problem
-from rcengine.io.jsonable import jsonable, read_json
+from rcengine.io.jsonable import jsonable, read_json, write_text_atomic
 from rcengine.network import RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.ground import annual_cycle
@@ -226,7 +226,7 @@ class ModelSpec:
         return cls.from_dict(data)
 
     def save(self, path: str | Path) -> None:
-        Path(path).write_text(self.to_json() + "\n")
+        write_text_atomic(path, self.to_json() + "\n")
 
     @classmethod
     def load(cls, path: str | Path) -> ModelSpec:
