@@ -6,6 +6,8 @@ module as their ``__main__`` when the server was started through it.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Annotated
 
 import typer
@@ -32,10 +34,43 @@ def _settings():
     return settings
 
 
+@contextmanager
+def _database_errors(settings) -> Iterator[None]:
+    """A database that cannot be opened, a schema newer than this code, a token file that
+    cannot be written: one line and exit code 2, not a traceback."""
+    from alembic.util.exc import CommandError
+    from sqlalchemy import make_url
+    from sqlalchemy.exc import SQLAlchemyError
+
+    try:
+        yield
+    except (SQLAlchemyError, CommandError, ModuleNotFoundError) as exc:
+        where = make_url(settings.database_url).render_as_string(hide_password=True)
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        typer.secho(f"error: database {where}: {reason}", fg=typer.colors.RED, err=True)
+        raise typer.Exit(code=2) from None
+    except OSError as exc:
+        typer.secho(
+            f"error: {exc.filename or 'a file'}: {exc.strerror or exc}",
+            fg=typer.colors.RED,
+            err=True,
+        )
+        raise typer.Exit(code=2) from None
+
+
+def _backend(make_backend, settings, dask: str | None):
+    """The backend ``--dask`` names; a malformed address is one line naming the option."""
+    try:
+        return make_backend(settings, dask)
+    except (ValueError, RuntimeError, OSError) as exc:
+        typer.secho(f"error: --dask {dask}: {exc}", fg=typer.colors.RED, err=True)
+        raise typer.Exit(code=2) from None
+
+
 @app.command()
 def serve(
     host: Annotated[str, typer.Option(help="interface to listen on")] = "127.0.0.1",
-    port: Annotated[int, typer.Option(help="TCP port")] = 8000,
+    port: Annotated[int, typer.Option(help="TCP port", min=1, max=65535)] = 8000,
 ) -> None:
     """Run the HTTP service (uvicorn) until Ctrl-C."""
     import uvicorn
@@ -77,10 +112,13 @@ def retrain_all(
     from .fleet import retrain_all as run_pass
 
     settings = _settings()
-    db = Database(settings.database_url)
+    with _database_errors(settings):
+        db = Database(settings.database_url)
     try:
-        db.migrate()
-        summary = run_pass(settings, db, make_backend(settings, dask), progress=progress)
+        with _database_errors(settings):
+            db.migrate()
+            backend = _backend(make_backend, settings, dask)
+            summary = run_pass(settings, db, backend, progress=progress)
     finally:
         db.dispose()
     for line in summary.lines():
@@ -100,10 +138,12 @@ def reset_admin_token() -> None:
     if settings.admin_token is not None:
         typer.echo("RCSERVICE_ADMIN_TOKEN is set: that value is the admin token; change it there")
         raise typer.Exit(code=2)
-    db = Database(settings.database_url)
+    with _database_errors(settings):
+        db = Database(settings.database_url)
     try:
-        db.migrate()
-        token, path = reset(settings, db)
+        with _database_errors(settings):
+            db.migrate()
+            token, path = reset(settings, db)
     finally:
         db.dispose()
     typer.echo(f"new admin token {token}\n  (also written to {path}); restart the server")

@@ -31,9 +31,11 @@ def admin_token_hash(settings: Settings, db: Database) -> str:
             _log_where(settings.token_file())
             return stored
         token = new_token()
+        # The file first, the hash then, in the same transaction: stored before a write that
+        # failed, the hash left a token nobody had (the next start found it and printed none).
+        path = settings.token_file()
+        write_secret(path, token)
         repository.replace_admin_token_hash(session, hash_token(token))
-    path = settings.token_file()
-    write_secret(path, token)
     print(f"rcservice: generated admin token {token}\n  (also written to {path})", flush=True)
     log.info("admin token generated", extra={"token_file": str(path)})
     return hash_token(token)
@@ -42,10 +44,12 @@ def admin_token_hash(settings: Settings, db: Database) -> str:
 def reset_admin_token(settings: Settings, db: Database) -> tuple[str, Path]:
     """Replace the stored admin token by a new one; returns it and the file it was written to."""
     token = new_token()
+    path = settings.token_file()
+    # Written before the hash is replaced: a file that cannot be written leaves the old token
+    # working, not a new one nobody has.
+    write_secret(path, token)
     with db.write() as session:
         repository.replace_admin_token_hash(session, hash_token(token))
-    path = settings.token_file()
-    write_secret(path, token)
     return token, path
 
 

@@ -8,6 +8,7 @@ from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 from sqlalchemy.engine import make_url
+from sqlalchemy.exc import ArgumentError
 
 from rcengine.estimation.estimator import check_criterion
 from rcengine.estimation.presets import settings_for
@@ -146,8 +147,18 @@ class Settings(BaseSettings):
     @field_validator("database_url")
     @classmethod
     def _parsable_url(cls, value: str) -> str:
-        make_url(value)  # raises ArgumentError on a malformed URL
+        try:
+            make_url(value)
+        except ArgumentError as exc:  # not a ValueError: pydantic would let it through raw
+            raise ValueError(f"not a database URL ({exc})") from None
         return value
+
+    @field_validator("log_level")
+    @classmethod
+    def _known_level(cls, value: str) -> str:
+        if value.upper() not in ("CRITICAL", "ERROR", "WARNING", "INFO", "DEBUG"):
+            raise ValueError(f"unknown log level {value!r}: CRITICAL, ERROR, WARNING, INFO, DEBUG")
+        return value.upper()
 
     @property
     def sqlite_path(self) -> Path | None:

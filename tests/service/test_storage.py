@@ -3,7 +3,9 @@ enforces, retraining selection, the scheduler and the ``rcservice`` command line
 
 from __future__ import annotations
 
+import hashlib
 import io
+import sqlite3
 from datetime import UTC, datetime, timedelta, timezone
 
 import numpy as np
@@ -189,6 +191,43 @@ def test_nightly_job_is_scheduled_at_the_local_hour(settings):
         scheduler.shutdown(wait=False)
         runner.shutdown()
         database.dispose()
+
+
+@pytest.mark.parametrize(
+    ("env", "args", "message"),
+    [
+        ({"RCSERVICE_DATABASE_URL": "sqlite:////nonexistent/dir/x.db"}, [], "unable to open"),
+        ({"RCSERVICE_DATABASE_URL": "notaurl"}, [], "not a database URL"),
+        ({"RCSERVICE_LOG_LEVEL": "NOPE"}, [], "unknown log level"),
+        ({}, ["--dask", "bogus"], "--dask bogus"),
+    ],
+)
+def test_the_service_command_says_what_is_wrong_in_one_line(
+    tmp_path, monkeypatch, env, args, message
+):
+    """Each was a traceback (probe of the command line, nineteenth session)."""
+    monkeypatch.setenv("RCSERVICE_DATABASE_URL", f"sqlite:///{tmp_path / 'rc.db'}")
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    result = CliRunner().invoke(cli, ["retrain-all", "--no-progress", *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.output and "Traceback" not in result.output
+
+
+def test_a_token_file_that_cannot_be_written_keeps_the_old_token(tmp_path, monkeypatch):
+    """The new hash was stored before the file was written: a failed write left a token nobody
+    had."""
+    monkeypatch.setenv("RCSERVICE_DATABASE_URL", f"sqlite:///{tmp_path / 'rc.db'}")
+    monkeypatch.setenv("RCSERVICE_ADMIN_TOKEN_FILE", str(tmp_path / "token"))
+    assert CliRunner().invoke(cli, ["reset-admin-token"]).exit_code == 0
+    token = (tmp_path / "token").read_text().strip()
+    # Under a file, not a folder: the new token cannot be written.
+    monkeypatch.setenv("RCSERVICE_ADMIN_TOKEN_FILE", str(tmp_path / "token" / "new"))
+    failed = CliRunner().invoke(cli, ["reset-admin-token"])
+    assert failed.exit_code == 2 and "Traceback" not in failed.output
+    with sqlite3.connect(tmp_path / "rc.db") as db:
+        (stored,) = db.execute("SELECT token_hash FROM admin_tokens").fetchone()
+    assert stored == hashlib.sha256(token.encode()).hexdigest()
 
 
 def test_invalid_settings_fail_at_start():
