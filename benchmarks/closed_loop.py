@@ -755,6 +755,8 @@ def report(args: argparse.Namespace) -> None:
     tuned = json.loads(args.settings.read_text())
     weeks = args.weeks or TEST_WEEKS
     suffix = "" if args.objective == "energy" else f"_{args.objective}"
+    if args.rows is not None:
+        args.rows.mkdir(parents=True, exist_ok=True)
     results = []
     for name in args.buildings:
         if name not in tuned:
