@@ -333,6 +333,8 @@ def diagnose(
             f"{train_fraction:g} is outside [{TRAIN_FRACTION[0]}, {TRAIN_FRACTION[1]}]",
             param_hint="--train-fraction",
         )
+    if model not in available_models():
+        fail(f"invalid model {model!r}; choose from {sorted(available_models())}")
     outputs = {"--json": json_out, "--html": html_out, "--save-model": save_model}
     for option, path in outputs.items():
         _output(path, option, data, building)

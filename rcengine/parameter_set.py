@@ -9,6 +9,7 @@ values with units and bounds; the fit window, metrics and engine version.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -168,7 +169,26 @@ class ParameterSet:
 
     @classmethod
     def load(cls, path: str | Path) -> ParameterSet:
-        return cls.from_dict(read_json(path, ModelError))
+        """A parameter file, checked: written by this engine's format or an older one, every
+        value finite and within its bounds (a hand-edited NaN or zero capacity forecast NaN
+        throughout, with exit code 0)."""
+        data = read_json(path, ModelError)
+        version = data.get("format_version", FORMAT_VERSION) if isinstance(data, dict) else None
+        if isinstance(version, int | float) and version > FORMAT_VERSION:
+            raise ModelError(
+                f"{path}: parameter file format {version} is newer than this engine's "
+                f"({FORMAT_VERSION}); upgrade rcengine"
+            )
+        pset = cls.from_dict(data)
+        for name, p in pset.compiled.parameters.items():
+            value = pset.values[name]
+            slack = 1e-9 * max(abs(p.lower), abs(p.upper))
+            if not (math.isfinite(value) and p.lower - slack <= value <= p.upper + slack):
+                raise ModelError(
+                    f"{path}: parameter {name} = {value:g} {p.unit} is outside its bounds "
+                    f"[{p.lower:g}, {p.upper:g}]"
+                )
+        return pset
 
 
 def _missing_entry(data: object, exc: KeyError) -> str:

@@ -407,3 +407,33 @@ def test_a_result_is_written_whole_or_the_old_file_stays(workdir, office_fit, mo
     assert result.exit_code == 2 and "No space left on device" in result.output
     assert Path("p.json").read_text() == '{"previous": true}\n'
     assert [p.name for p in Path().iterdir() if p.name.startswith(".p.json")] == []
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"value": float("nan")}, "is outside its bounds"),
+        ({"value": -1.0}, "is outside its bounds"),
+        ({"value": 1e308}, "is outside its bounds"),
+    ],
+)
+def test_a_hand_edited_parameter_file_is_refused(workdir, office_fit, change, message):
+    """A NaN or a negative resistance forecast NaN (or nonsense) with exit code 0."""
+    document = json.loads(office_fit["path"].read_text())
+    document["parameters"]["r_wall_ext"].update(change)
+    Path("params.json").write_text(json.dumps(document))
+    assert_refused(predict_day("params.json"), message)
+
+
+def test_a_parameter_file_of_a_newer_format_is_refused(workdir, office_fit):
+    document = {**json.loads(office_fit["path"].read_text()), "format_version": 99}
+    Path("params.json").write_text(json.dumps(document))
+    assert_refused(predict_day("params.json"), "newer than this engine's")
+
+
+def test_a_fit_on_fewer_rows_than_unknowns_is_refused(workdir):
+    lines = Path("data.csv").read_text().splitlines()[:4]
+    Path("data.csv").write_text("\n".join(lines) + "\n")
+    result = invoke(*FIT, "-o", "p.json")
+    assert result.exit_code == 2 and "cannot calibrate 11 unknowns" in result.output
+    assert "Traceback" not in result.output and not Path("p.json").exists()

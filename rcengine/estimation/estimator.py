@@ -30,7 +30,13 @@ from rcengine.estimation.objective import Objective, Trajectory
 from rcengine.estimation.pattern_search import GPSSettings
 from rcengine.estimation.presets import EstimatorSettings, settings_for
 from rcengine.estimation.search_space import SearchSpace
-from rcengine.exceptions import ConvergenceWarning, ModelError, NotFittedError
+from rcengine.exceptions import (
+    ConvergenceWarning,
+    DataValidationError,
+    ModelError,
+    NotFittedError,
+    Problem,
+)
 from rcengine.kalman import Noise
 from rcengine.metrics import rmse
 from rcengine.network import CompiledNetwork, RCNetwork
@@ -70,6 +76,26 @@ class Identifiability:
 # Relative tolerances of the least-squares polish: far below any physical significance of the
 # parameters, well above the round-off of the exact simulation.
 POLISH_TOL = 1e-5
+
+
+def _check_enough_measured(data: Dataset, n_params: int, n_states: int) -> None:
+    """More measured t_in than unknowns (the parameters and each segment's initial
+    temperatures): fitted on two rows, 8 parameters reproduced them exactly and the fit
+    "passed" ASHRAE Guideline 14."""
+    measured = int(np.isfinite(data.measured).sum())
+    unknowns = n_params + n_states * len(data.segments)
+    if measured <= unknowns:
+        raise DataValidationError(
+            [
+                Problem(
+                    None,
+                    "t_in",
+                    f"{measured} measured value(s) cannot calibrate {unknowns} unknowns "
+                    f"({n_params} parameters, {n_states} initial temperatures per segment × "
+                    f"{len(data.segments)} segment(s)); give a longer record",
+                )
+            ]
+        )
 
 
 def search(
@@ -161,6 +187,7 @@ class Estimator:
         settings = self._settings()
         network = self.compiled
         space = SearchSpace(network, self.known, self.bounds)
+        _check_enough_measured(data, space.dim, network.n_states)
         objective = Objective(network, data, self.cost)
         rng = np.random.default_rng(self.random_state)
         self.ga_ = self.gps_ = self.polish_ = self.likelihood_ = self.noise_ = None
