@@ -276,9 +276,13 @@ def predict(
         pset = ParameterSet.load(params)
         first = _instant(start, "--start", pset.building.location.timezone)
         frame = read_timeseries(data)
-        fc, _ = forecast_frame(
-            pset.compiled, pset.values, frame, pset.prepare, first, hours, noise=pset.noise
-        )
+        try:
+            fc, _ = forecast_frame(
+                pset.compiled, pset.values, frame, pset.prepare, first, hours, noise=pset.noise
+            )
+        except DataValidationError as exc:
+            # What the data lack at or before this start (the state's history, future inputs).
+            fail(f"--start {start}: " + "; ".join(str(p) for p in exc.problems[:5]))
         frame = fc.to_frame(std)
         text = io.StringIO()
         write_timeseries(frame, text, pset.building.location.timezone)

@@ -78,6 +78,17 @@ def serve(
     from .main import create_app
 
     settings = _settings()
+    if settings.sqlite_path is None:
+        # A database server that cannot be reached or migrated: one line before uvicorn starts,
+        # not the startup's traceback inside a JSON log line.
+        from .core.db import Database
+
+        with _database_errors(settings):
+            db = Database(settings.database_url)
+            try:
+                db.migrate()
+            finally:
+                db.dispose()
     shown = "localhost" if host in ("0.0.0.0", "::") else host
     typer.echo(f"rcservice: API docs at http://{shown}:{port}/docs (OpenAPI: /openapi.json)")
     if settings.admin_token is not None:

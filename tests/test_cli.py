@@ -437,3 +437,12 @@ def test_a_fit_on_fewer_rows_than_unknowns_is_refused(workdir):
     result = invoke(*FIT, "-o", "p.json")
     assert result.exit_code == 2 and "cannot calibrate 11 unknowns" in result.output
     assert "Traceback" not in result.output and not Path("p.json").exists()
+
+
+def test_a_forecast_start_the_data_cannot_start_names_the_option(workdir, office_fit):
+    Path("params.json").write_text(office_fit["path"].read_text())
+    result = invoke(
+        "predict", "data.csv", "--params", "params.json", "--start", "2017-03-01",
+        "--hours", "24", "-o", "f.csv",
+    )  # fmt: skip
+    assert_refused(result, "--start 2017-03-01: column 't_in': no measurements in the step before")

@@ -214,6 +214,13 @@ def test_the_service_command_says_what_is_wrong_in_one_line(
     assert message in result.output and "Traceback" not in result.output
 
 
+def test_serve_says_in_one_line_that_its_database_server_cannot_be_reached(monkeypatch):
+    monkeypatch.setenv("RCSERVICE_DATABASE_URL", "postgresql+psycopg://nobody@127.0.0.1:1/x")
+    result = CliRunner().invoke(cli, ["serve", "--port", "18767"])
+    assert result.exit_code == 2, result.output
+    assert "Connection refused" in result.output and "Traceback" not in result.output
+
+
 def test_a_token_file_that_cannot_be_written_keeps_the_old_token(tmp_path, monkeypatch):
     """The new hash was stored before the file was written: a failed write left a token nobody
     had."""
