@@ -119,12 +119,18 @@ class Dataset:
                 f"(columns: {list(self.frame.columns)})"
             )
         u = self.frame[list(names)].to_numpy(dtype=float)
-        bad_rows, bad_cols = np.nonzero(~np.isfinite(u))
-        if bad_rows.size:
-            problems = [
-                Problem(int(r), names[c], "input value missing or not finite")
-                for r, c in zip(bad_rows[:20], bad_cols[:20], strict=True)
-            ]
+        bad = ~np.isfinite(u)
+        if bad.any():
+            # One problem per column, by time: the rows of a window cut from a longer record
+            # (a calibration's, a forecast's history) are positions nobody can look up.
+            problems = []
+            for c in np.flatnonzero(bad.any(axis=0)):
+                times = self.frame.index[bad[:, c]]
+                first, last = times[0].isoformat(), times[-1].isoformat()
+                span = f"at {first}"
+                if len(times) > 1:
+                    span = f"at {len(times)} rows, {first} to {last}"
+                problems.append(Problem(None, names[c], f"input missing or not finite {span}"))
             raise DataValidationError(problems)
         return u
 

@@ -67,3 +67,16 @@ def test_random_dropouts_leave_the_fit_as_on_the_whole_record(project_data):
     assert bridged.rmse_ == pytest.approx(reference.rmse_, rel=0.05)
     for name, value in reference.params_.items():
         assert bridged.params_[name] == pytest.approx(value, rel=0.1, abs=1e-3), name
+
+
+def test_a_missing_input_is_named_by_its_column_and_times():
+    """Rows of a window cut from a longer record were named by their positions in it."""
+    from rcengine.exceptions import DataValidationError
+
+    times = pd.date_range("2017-01-01", periods=4, freq="15min", tz="UTC")
+    frame = pd.DataFrame({"q_occ": [1.0, np.nan, np.nan, 4.0], "t_out": 1.0}, index=times)
+    with pytest.raises(DataValidationError) as caught:
+        Dataset.from_frame(frame).inputs(["t_out", "q_occ"])
+    (problem,) = caught.value.problems
+    assert (problem.row, problem.column) == (None, "q_occ")
+    assert "2 rows, 2017-01-01T00:15:00+00:00 to 2017-01-01T00:30:00+00:00" in problem.message
