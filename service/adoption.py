@@ -71,7 +71,12 @@ def spec_of(building: BuildingRecord) -> ModelSpec | None:
 
 def job_model(spec: ModelSpec | None, default: str) -> str:
     """What a calibration job is labelled with: the adopted model's name, else ``default``."""
-    return default if spec is None else spec.name[:JOB_MODEL_CHARS]
+    return default if spec is None else job_label(spec.name)
+
+
+def job_label(model: str) -> str:
+    """A model's name as the jobs table holds it."""
+    return model[:JOB_MODEL_CHARS]
 
 
 def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> Change:

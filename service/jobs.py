@@ -178,7 +178,9 @@ def run_leased(
                 outcome=product.outcome,
                 details=details,
                 lease=lease,
-                model=details.get("model"),
+                # The model fitted, as the queued label was cut (an extended model's name can
+                # outgrow the column, which PostgreSQL refuses).
+                model=adoption.job_label(details["model"]) if "model" in details else None,
             )
     log.info(
         "%s finished",

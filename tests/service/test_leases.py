@@ -121,6 +121,27 @@ def test_a_live_run_renews_its_lease_while_it_works(db, job_id):
     assert fail_abandoned(db) == []
 
 
+@dataclass(frozen=True)
+class Fitted:
+    """A product that fitted a model whose name outgrows the jobs table's label."""
+
+    model: str
+    outcome: str = "rejected"
+
+    def save(self, session, job) -> dict:
+        return {"model": self.model}
+
+
+def test_a_job_records_the_model_it_fitted_within_the_label_the_table_holds(db, job_id):
+    """An extended model's name can exceed the column; cut as the queued label is (PostgreSQL
+    refuses a longer value, and the job would end in an error)."""
+    long_name = "basic+" + "+".join(["wind_infiltration", "ventilation_schedule"] * 4)
+    assert len(long_name) > 100
+    run = execute(db, job_id, lambda *_: Fitted(long_name), None, LeaseTerms("live", 60.0))
+    assert run == "succeeded"
+    assert job(db, job_id).model == long_name[:100]
+
+
 WORKER_SCRIPT = textwrap.dedent(
     """
     import os, subprocess, sys, time
