@@ -39,8 +39,8 @@ from rcengine.estimation.estimator import CRITERIA, check_criterion
 from rcengine.estimation.likelihood import LikelihoodFit
 from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
 from rcengine.forecast import forecast_frame
+from rcengine.io.files import write_text_atomic
 from rcengine.io.instants import parse_instant
-from rcengine.io.jsonable import write_text_atomic
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
 from rcengine.models.spec import ModelSpec, check_columns

@@ -22,7 +22,8 @@ from rcengine.building import Building
 from rcengine.dataset import Dataset
 from rcengine.estimation.estimator import Estimator
 from rcengine.exceptions import ModelError
-from rcengine.io.jsonable import jsonable, read_json, write_text_atomic
+from rcengine.io.files import write_text_atomic
+from rcengine.io.jsonable import jsonable, read_json
 from rcengine.kalman import Noise
 from rcengine.metrics import evaluate
 from rcengine.network import CompiledNetwork, RCNetwork

@@ -81,14 +81,13 @@ def whole_columns(frame: pd.DataFrame) -> tuple[pd.DataFrame, list[str]]:
     others, and an upload cannot erase a value once stored. A model fed such a column meets
     missing inputs; without it, the window is fitted on what every row has (the note says
     so). Required columns stay: a row without them is refused at upload."""
+    missing = frame.isna()
     partial = [
-        c
-        for c in frame.columns
-        if c in COLUMNS and not COLUMNS[c].required and frame[c].isna().any()
+        c for c in frame.columns if c in COLUMNS and not COLUMNS[c].required and missing[c].any()
     ]
     notes = [
-        f"column '{c}' left out: missing in {int(frame[c].isna().sum())} of {len(frame)} rows "
-        f"of the window ({frame.index[frame[c].isna().to_numpy()][0].isoformat()} first)"
+        f"column '{c}' left out: missing in {int(missing[c].sum())} of {len(frame)} rows "
+        f"of the window ({missing.index[missing[c]][0].isoformat()} first)"
         for c in partial
     ]
     return frame.drop(columns=partial), notes

@@ -72,13 +72,18 @@ def day_ahead_errors(
 def day_ahead_block(baseline: Fit, final: Fit, timezone: str) -> dict:
     """The report's ``day_ahead``: pooled RMSE [K] of the base and final models' day-ahead
     forecasts over the test half's days."""
-    out: dict = {"horizon_h": HORIZON_H, "history_h": DEFAULT_HISTORY_H}
-    for name, fit in (("baseline", baseline), ("final", final)):
-        if name == "final" and final is baseline:
-            out["rmse_final"] = out["rmse_baseline"]
-            break
-        errors, days = day_ahead_errors(fit.network, fit.params, fit.split, timezone)
-        errors = errors[np.isfinite(errors)]
-        out[f"rmse_{name}"] = float(np.sqrt(np.mean(errors**2))) if errors.size else None
-        out["days"] = days
-    return out
+    rmse_baseline, days = _pooled_rmse(baseline, timezone)
+    rmse_final = rmse_baseline if final is baseline else _pooled_rmse(final, timezone)[0]
+    return {
+        "horizon_h": HORIZON_H,
+        "history_h": DEFAULT_HISTORY_H,
+        "rmse_baseline": rmse_baseline,
+        "days": days,
+        "rmse_final": rmse_final,
+    }
+
+
+def _pooled_rmse(fit: Fit, timezone: str) -> tuple[float | None, int]:
+    errors, days = day_ahead_errors(fit.network, fit.params, fit.split, timezone)
+    errors = errors[np.isfinite(errors)]
+    return (float(np.sqrt(np.mean(errors**2))) if errors.size else None), days

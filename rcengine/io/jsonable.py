@@ -55,21 +55,3 @@ def read_json(path: str | Path, error: type[Exception]) -> Any:
         raise error(f"{path}: not a JSON text file (not UTF-8: {exc.reason})") from exc
     except OSError as exc:
         raise error(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
-
-
-def write_text_atomic(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` whole or not at all: into a temporary file beside it, then
-    renamed over it. Written in place, a full disk or a killed process left half a file where
-    the previous good one had been."""
-    import os
-    import tempfile
-
-    target = Path(path)
-    fd, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(temporary, target)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise

@@ -38,7 +38,8 @@ from rcengine.columns import (
     T_OUT,
 )
 from rcengine.exceptions import DataValidationError, ModelError, Problem
-from rcengine.io.jsonable import jsonable, read_json, write_text_atomic
+from rcengine.io.files import write_text_atomic
+from rcengine.io.jsonable import jsonable, read_json
 from rcengine.network import RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.ground import annual_cycle
