@@ -52,8 +52,6 @@ ADOPT, REVERT = "adopt", "revert"
 # Who made a change: the admin token, the building's own token, or the automatic adoption of a
 # diagnosis's findings (RCSERVICE_AUTO_ADOPT).
 ADMIN, BUILDING, AUTO = "admin", "building", "auto"
-# Room for a long extended model's name in the jobs table.
-JOB_MODEL_CHARS = 100
 
 
 @dataclass(frozen=True)
@@ -71,12 +69,7 @@ def spec_of(building: BuildingRecord) -> ModelSpec | None:
 
 def job_model(spec: ModelSpec | None, default: str) -> str:
     """What a calibration job is labelled with: the adopted model's name, else ``default``."""
-    return default if spec is None else job_label(spec.name)
-
-
-def job_label(model: str) -> str:
-    """A model's name as the jobs table holds it."""
-    return model[:JOB_MODEL_CHARS]
+    return default if spec is None else spec.name
 
 
 def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> Change:
@@ -119,9 +112,12 @@ def revert(session: Session, building_id: int, actor: str) -> Change:
     return Change(record, None)
 
 
-def calibrate_now(runner: JobRunner, building_id: int, change: Change) -> None:
+def calibrate_now(
+    runner: JobRunner, building_id: int, change: Change, follow_up: bool = False
+) -> None:
     """The first calibration of the model a change put in use, started at once, and recorded
-    with the change (or why none could start: one is already running, no measured data)."""
+    with the change (or why none could start: one is already running, no measured data).
+    ``follow_up``: started after a calibration that fitted the model before the change."""
     if not change.record.changed:
         return
     settings = runner.settings
@@ -141,6 +137,9 @@ def calibrate_now(runner: JobRunner, building_id: int, change: Change) -> None:
         record.calibration_job_id = job_id
         if note is not None:
             record.detail = {**(record.detail or {}), "calibration": note}
+        elif follow_up:
+            followed = "started when the calibration running at the change had ended"
+            record.detail = {**(record.detail or {}), "calibration": followed}
 
 
 def after_diagnosis(runner: JobRunner, job_id: int, done: Future) -> None:
@@ -160,6 +159,26 @@ def after_diagnosis(runner: JobRunner, job_id: int, done: Future) -> None:
         log.warning("automatic adoption failed", extra={"job_id": job_id, "error": str(exc)})
     except Exception:  # a callback's error would vanish; the diagnosis itself succeeded
         log.exception("automatic adoption failed", extra={"job_id": job_id})
+
+
+def after_calibrations(runner: JobRunner, job_ids: list[int]) -> None:
+    """Calibrations that fitted a model the building no longer uses — adopted or reverted while
+    they ran, when the change could not start its own calibration (one was running) — are
+    followed at once by the first calibration of the model in use; else the change waited for
+    the next night. Called when the calibrations have ended; it never raises."""
+    try:
+        for job_id in job_ids:
+            with runner.db.session() as session:
+                job = repository.get_job(session, job_id)
+                change = latest_change(session, job.building_id)
+                spec = spec_of(repository.get_building(session, job.building_id))
+            stale = job.status == SUCCEEDED and (job.details or {}).get("model_changed")
+            if stale and change is not None:
+                calibrate_now(runner, job.building_id, Change(change, spec), follow_up=True)
+    except (RCEngineError, ServiceError) as exc:
+        log.warning("no follow-up calibration", extra={"job_ids": job_ids, "error": str(exc)})
+    except Exception:  # a callback's error would vanish; the calibrations themselves ended
+        log.exception("no follow-up calibration", extra={"job_ids": job_ids})
 
 
 def history(session: Session, building_id: int) -> list[ModelChangeRecord]:

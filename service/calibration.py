@@ -107,9 +107,10 @@ class Calibrated:
         building = repository.lock_building(session, job.building_id)
         in_use = _adopted(building.model_spec)
         fitted = self.parameter_set.model
-        if (in_use is not None and fitted != in_use.name) or (
+        changed = (in_use is not None and fitted != in_use.name) or (
             in_use is None and fitted not in MODELS
-        ):
+        )
+        if changed:
             now = in_use.name if in_use is not None else "the base model"
             self.promote = False
             self.reason = f"the building's model changed to {now} while this calibration ran"
@@ -124,6 +125,7 @@ class Calibrated:
         return {
             "parameter_set_id": record.id,
             "model": self.parameter_set.model,
+            "model_changed": changed,
             "reason": self.reason,
             "window": self.window.to_dict(),
             "training_rows": fit["rows"],

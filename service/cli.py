@@ -12,6 +12,8 @@ from typing import Annotated
 
 import typer
 
+from rcengine.io.files import file_error
+
 app = typer.Typer(
     help="The rcengine calibration service (FastAPI).",
     no_args_is_help=True,
@@ -50,11 +52,7 @@ def _database_errors(settings) -> Iterator[None]:
         typer.secho(f"error: database {where}: {reason}", fg=typer.colors.RED, err=True)
         raise typer.Exit(code=2) from None
     except OSError as exc:
-        typer.secho(
-            f"error: {exc.filename or 'a file'}: {exc.strerror or exc}",
-            fg=typer.colors.RED,
-            err=True,
-        )
+        typer.secho(f"error: {file_error(exc)}", fg=typer.colors.RED, err=True)
         raise typer.Exit(code=2) from None
 
 

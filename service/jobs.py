@@ -178,9 +178,8 @@ def run_leased(
                 outcome=product.outcome,
                 details=details,
                 lease=lease,
-                # The model fitted, as the queued label was cut (an extended model's name can
-                # outgrow the column, which PostgreSQL refuses).
-                model=adoption.job_label(details["model"]) if "model" in details else None,
+                # The model fitted: a revert or an adoption while the job ran changes it.
+                model=details.get("model"),
             )
     log.info(
         "%s finished",
@@ -301,6 +300,8 @@ class JobRunner:
         work, options = self._kinds[kind]
         future = self._submit(execute, job_id, work, options, self.terms)
         future.add_done_callback(lambda f: self._finished(job_id, f))
+        if kind == CALIBRATION:
+            future.add_done_callback(lambda f: adoption.after_calibrations(self, [job_id]))
         if kind == DIAGNOSIS and self.settings.auto_adopt:
             future.add_done_callback(lambda f: adoption.after_diagnosis(self, job_id, f))
 
@@ -308,6 +309,8 @@ class JobRunner:
         work, options = self._kinds[kind]
         future = self._submit(drain, kind, work, options, self.terms, building_ids)
         future.add_done_callback(self._drained)
+        if kind == CALIBRATION:
+            future.add_done_callback(self._follow_up)
         return future
 
     def _submit(self, entry: Callable[..., Any], first: Any, work: Work, *rest: Any) -> Future:
@@ -366,6 +369,10 @@ class JobRunner:
         # died) leaves its current job to the reaper, once the lease expires.
         if not future.cancelled() and future.exception() is not None:
             log.error("job slot ended abnormally", extra={"error": describe(future.exception())})
+
+    def _follow_up(self, drained: Future) -> None:
+        if not drained.cancelled() and drained.exception() is None:
+            adoption.after_calibrations(self, list(drained.result()))
 
     def _new_executor(self) -> Executor:
         return self.backend.new_executor()

@@ -143,7 +143,7 @@ class JobRecord(Base):
     status: Mapped[str] = mapped_column(String(16), default=QUEUED)
     outcome: Mapped[str | None] = mapped_column(String(16))
     trigger: Mapped[str] = mapped_column(String(16))
-    model: Mapped[str] = mapped_column(String(100))
+    model: Mapped[str] = mapped_column(Text)
     days: Mapped[int] = mapped_column(Integer)
     data_revision: Mapped[int] = mapped_column(Integer)
     created_at: Mapped[datetime] = mapped_column(default=utc_now)
@@ -187,7 +187,7 @@ class JobProduct:
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     building_id: Mapped[int] = mapped_column(ForeignKey("buildings.id", ondelete="CASCADE"))
     job_id: Mapped[int | None] = mapped_column(ForeignKey("jobs.id", ondelete="SET NULL"))
-    model: Mapped[str] = mapped_column(String(100))
+    model: Mapped[str] = mapped_column(Text)
     engine_version: Mapped[str] = mapped_column(String(32))
     created_at: Mapped[datetime] = mapped_column(default=utc_now)
 
@@ -248,7 +248,7 @@ class ModelChangeRecord(Base):
     diagnosis_id: Mapped[int | None] = mapped_column(
         ForeignKey("diagnoses.id", ondelete="SET NULL")
     )
-    model: Mapped[str | None] = mapped_column(String(200))
+    model: Mapped[str | None] = mapped_column(Text)
     actor: Mapped[str] = mapped_column(String(32))
     changed: Mapped[bool] = mapped_column(default=False)
     calibration_job_id: Mapped[int | None] = mapped_column(

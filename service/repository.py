@@ -261,12 +261,7 @@ def add_job(
 ) -> JobRecord:
     """A queued job; ConflictError when the building already has one of this kind queued or
     running."""
-    active = active_job(session, building_id, kind)
-    if active is not None:
-        raise ConflictError(
-            f"building {building_id} already has {kind} job {active.id} {active.status}; "
-            f"poll GET /jobs/{active.id}"
-        )
+    _refuse_a_second(session, building_id, kind)
     building = get_building(session, building_id)
     job = JobRecord(
         building_id=building_id,
@@ -282,8 +277,19 @@ def add_job(
         with session.begin_nested():
             session.add(job)
     except IntegrityError as exc:  # another process queued one between the check and now
+        _refuse_a_second(session, building_id, kind)
         raise ConflictError(f"building {building_id} already has an active {kind}") from exc
     return job
+
+
+def _refuse_a_second(session: Session, building_id: int, kind: str) -> None:
+    """ConflictError naming the building's active job of ``kind`` (queued or running), if any."""
+    active = active_job(session, building_id, kind)
+    if active is not None:
+        raise ConflictError(
+            f"building {building_id} already has {kind} job {active.id} {active.status}; "
+            f"poll GET /jobs/{active.id}"
+        )
 
 
 def active_job(session: Session, building_id: int, kind: str = CALIBRATION) -> JobRecord | None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -59,3 +60,5 @@ class PostgresServer:
 
     def stop(self) -> None:
         self._server.cleanup()
+        # cleanup() deletes the data folder, not the temporary folder made for it.
+        shutil.rmtree(self.folder, ignore_errors=True)

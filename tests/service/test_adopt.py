@@ -444,3 +444,50 @@ def test_a_set_of_a_model_reverted_while_it_was_fitted_is_not_served(client, ado
     after = client.get(f"/buildings/{building_id}", headers=headers).json()
     assert after["current_parameter_set_id"] == served["current_parameter_set_id"]
     assert forecast(client, building_id, headers).json()["parameter_set"]["model"] == "basic"
+
+
+def test_an_adoption_during_a_calibration_calibrates_the_adopted_model_after_it(
+    client, truth, monkeypatch
+):
+    """Adopted while the base model's calibration ran: that calibration's set is stored
+    rejected, and the adopted model's first calibration, which the adoption could not start,
+    starts as soon as it ends (it used to wait for the next night)."""
+    import threading
+
+    from service import calibration
+
+    building_id, headers = register(client)
+    upload = truth.iloc[: 4 * DAY]
+    client.post(
+        f"/buildings/{building_id}/measurements", json={"rows": json_rows(upload)}, headers=headers
+    )
+    diagnosis_id = diagnosed(client, building_id, headers, monkeypatch)
+    entered, release, compute = threading.Event(), threading.Event(), calibration.compute
+
+    def held(inputs, options):
+        entered.set()
+        release.wait(timeout=60.0)
+        return compute(inputs, options)
+
+    monkeypatch.setattr(calibration, "compute", held)
+    running = client.post(f"/buildings/{building_id}/calibrations", json={}, headers=headers)
+    # Adopted once the calibration has read the model to fit (a job that has not started yet
+    # fits the adopted model, and needs no follow-up).
+    assert entered.wait(timeout=60.0)
+    url = f"/buildings/{building_id}/diagnoses/{diagnosis_id}/adopt"
+    adopt = client.post(url, headers=headers).json()
+    assert adopt["changed"] and adopt["calibration_job_id"] is None
+    assert "already has calibration job" in adopt["detail"]["calibration"]
+    release.set()
+    first = wait_for_job(client, running.json()["id"], headers)
+    assert first["outcome"] == "rejected" and first["details"]["model_changed"]
+    url = f"/buildings/{building_id}/model/changes"
+    change = {}
+    for _ in range(200):  # the follow-up starts in the finished calibration's callback
+        change = client.get(url, headers=headers).json()["items"][-1]
+        if change["calibration_job_id"] is not None:
+            break
+        time.sleep(0.05)
+    follow_up = wait_for_job(client, change["calibration_job_id"], headers)
+    assert follow_up["status"] == "succeeded" and follow_up["model"] == wind_network().name
+    assert change["detail"]["calibration"].startswith("started when the calibration running")

@@ -324,7 +324,7 @@ def test_migration_applies_on_a_fresh_sqlite_file(tmp_path):
     tables = inspect(db.engine)
     assert "diagnoses" in tables.get_table_names()
     assert {"kind", "options"} <= {c["name"] for c in tables.get_columns("jobs")}
-    assert schema_revision(db) == "0005"
+    assert schema_revision(db) == "0006"
     db.dispose()
 
 

@@ -10,13 +10,14 @@ import sys
 import textwrap
 import time
 from dataclasses import dataclass
+from datetime import UTC, datetime
 
 import pytest
 
 import service.jobs
 from service import repository
 from service.core.db import Database
-from service.errors import LeaseLostError
+from service.errors import ConflictError, LeaseLostError
 from service.jobs import LeaseTerms, execute, fail_abandoned, fail_interrupted
 from service.models import CALIBRATION, FAILED, RUNNING, ParameterSetRecord
 
@@ -123,23 +124,40 @@ def test_a_live_run_renews_its_lease_while_it_works(db, job_id):
 
 @dataclass(frozen=True)
 class Fitted:
-    """A product that fitted a model whose name outgrows the jobs table's label."""
+    """A product that fitted, and stores a set of, a model with a long name."""
 
     model: str
     outcome: str = "rejected"
 
     def save(self, session, job) -> dict:
+        when = datetime(2017, 1, 30, tzinfo=UTC)
+        record = ParameterSetRecord(
+            building_id=job.building_id,
+            job_id=job.id,
+            model=self.model,
+            engine_version="test",
+            train_start=when,
+            train_end=when,
+            rmse_train=0.1,
+            rmse_holdout=None,
+            metrics={},
+            document={},
+        )
+        repository.add_parameter_set(session, record, promote=False)
         return {"model": self.model}
 
 
-def test_a_job_records_the_model_it_fitted_within_the_label_the_table_holds(db, job_id):
-    """An extended model's name can exceed the column; cut as the queued label is (PostgreSQL
-    refuses a longer value, and the job would end in an error)."""
-    long_name = "basic+" + "+".join(["wind_infiltration", "ventilation_schedule"] * 4)
-    assert len(long_name) > 100
+def test_a_job_records_and_stores_a_model_name_of_any_length(db, job_id):
+    """An extended model's name grows with each effect it adopts; PostgreSQL refused one past
+    the 100 characters the tables once held, after the set was fitted (migration 0006)."""
+    long_name = "basic+" + "+".join(["wind_infiltration", "ventilation_schedule"] * 6)
+    assert len(long_name) > 200
     run = execute(db, job_id, lambda *_: Fitted(long_name), None, LeaseTerms("live", 60.0))
     assert run == "succeeded"
-    assert job(db, job_id).model == long_name[:100]
+    assert job(db, job_id).model == long_name
+    with db.session() as session:
+        stored = repository.list_parameter_sets(session, job(db, job_id).building_id)
+    assert [s.model for s in stored] == [long_name]
 
 
 WORKER_SCRIPT = textwrap.dedent(
@@ -180,3 +198,24 @@ def _alive(pid: int) -> bool:
             return stat.read().split(") ")[1][0] != "Z"  # a zombie is dead
     except FileNotFoundError:
         return False
+
+
+def test_a_job_queued_by_another_process_at_the_same_moment_is_named(db, monkeypatch):
+    """Two processes queue a calibration at once: both see none active, the database's unique
+    index refuses the second, and its 409 names the first (it said only "an active calibration",
+    no job to poll)."""
+    with db.write() as session:
+        building = repository.add_building(session, "b", {}, "Europe/Rome", "h" * 64)
+        first = repository.add_job(session, building.id, "api", "basic", 1, CALIBRATION)
+    looked = []
+    real = repository.active_job
+
+    def first_look_misses(session, building_id, kind=CALIBRATION):
+        looked.append(kind)
+        return None if len(looked) == 1 else real(session, building_id, kind)
+
+    monkeypatch.setattr(repository, "active_job", first_look_misses)
+    named = f"job {first.id} queued; poll GET /jobs/{first.id}"
+    with pytest.raises(ConflictError, match=named), db.write() as session:
+        repository.add_job(session, building.id, "api", "basic", 1, CALIBRATION)
+    assert len(looked) == 2
