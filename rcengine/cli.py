@@ -39,7 +39,7 @@ from rcengine.estimation.estimator import CRITERIA, check_criterion
 from rcengine.estimation.likelihood import LikelihoodFit
 from rcengine.exceptions import ConvergenceWarning, DataValidationError, RCEngineError
 from rcengine.forecast import forecast_frame
-from rcengine.io.files import write_text_atomic
+from rcengine.io.files import file_error, write_text_atomic
 from rcengine.io.instants import parse_instant
 from rcengine.io.timeseries import read_timeseries, write_timeseries
 from rcengine.models import available_models, get_model
@@ -88,7 +88,7 @@ def _run(fn):
     except RCEngineError as exc:
         fail(str(exc))
     except OSError as exc:
-        fail(f"{exc.filename or 'a file'}: {exc.strerror or exc}")
+        fail(file_error(exc))
 
 
 def _output(path: Path | None, option: str, *inputs: Path | None) -> None:

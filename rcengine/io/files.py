@@ -1,4 +1,4 @@
-"""Writing result files whole or not at all."""
+"""Writing result files whole or not at all, and saying in one line why a file could not be."""
 
 from __future__ import annotations
 
@@ -20,3 +20,9 @@ def write_text_atomic(path: str | Path, text: str) -> None:
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+def file_error(exc: OSError) -> str:
+    """An operating-system error in one line: the file and the reason (a full disk, a missing
+    folder, no permission), for a command line to print instead of a traceback."""
+    return f"{exc.filename or 'a file'}: {exc.strerror or exc}"

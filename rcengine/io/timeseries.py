@@ -270,6 +270,15 @@ def _near_miss(name: str, columns: pd.Index) -> str:
 
 
 # --- time -------------------------------------------------------------------------------------
+def _outside_supported(outside: np.ndarray, text: pd.Series, problems: _Problems) -> None:
+    """Report the rows whose time lies outside the supported years (``instants.SUPPORTED``)."""
+    problems.add_rows(
+        np.flatnonzero(outside),
+        TIME,
+        lambda r: f"time {text[r]!r} is outside the supported range {SUPPORTED_TEXT}",
+    )
+
+
 def _parse_times(cells: pd.Series, problems: _Problems) -> tuple[np.ndarray, pd.Series]:
     """Nanoseconds since the epoch (UTC) per row, NaT where a cell is bad (reported), and the
     cell texts for messages."""
@@ -279,11 +288,7 @@ def _parse_times(cells: pd.Series, problems: _Problems) -> tuple[np.ndarray, pd.
         problems.add_rows(np.flatnonzero(ns == _NAT), TIME, lambda r: "time is empty")
         bounds = [SUPPORTED[0].value, SUPPORTED[1].value]
         outside = (ns != _NAT) & ((ns < bounds[0]) | (ns >= bounds[1]))
-        problems.add_rows(
-            np.flatnonzero(outside),
-            TIME,
-            lambda r: f"time {text[r]!r} is outside the supported range {SUPPORTED_TEXT}",
-        )
+        _outside_supported(outside, text, problems)
         ns[outside] = _NAT
         return ns, text
     cell_text = _as_text(cells)
@@ -298,11 +303,7 @@ def _parse_times(cells: pd.Series, problems: _Problems) -> tuple[np.ndarray, pd.
     text = cell_text.map(_shown)
     # pandas parses years 1–9999 at a coarser unit (``instants.SUPPORTED`` says why the range).
     outside = ok & ~np.asarray(parsed.isna() | ((parsed >= SUPPORTED[0]) & (parsed < SUPPORTED[1])))
-    problems.add_rows(
-        np.flatnonzero(outside),
-        TIME,
-        lambda r: f"time {text[r]!r} is outside the supported range {SUPPORTED_TEXT}",
-    )
+    _outside_supported(outside, text, problems)
     ok = ok & ~outside
     ns = parsed.where(~outside).as_unit("ns").asi8.copy()
     invalid = ok & (ns == _NAT)
