@@ -59,7 +59,14 @@ from rcengine.diagnose.response import (
     on_off_explainer,
     parameter_sensitivities,
 )
-from rcengine.models.bounds import R_SE, RHO_CP_AIR, U_OPAQUE, envelope, internal_resistance
+from rcengine.models.bounds import (
+    R_SE,
+    R_SE_SHELTERED,
+    RHO_CP_AIR,
+    U_OPAQUE,
+    envelope,
+    internal_resistance,
+)
 from rcengine.models.physical import steady_share
 from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
@@ -283,7 +290,10 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
     their test error), which one envelope's sun cannot do. The sun ``solar_opaque_<k>``
     (A_k × plane-of-array irradiance [W]) enters the envelope node, scaled by R_se over the share
     of that node's heat that warms the room under the current fit (``steady_share``), so that
-    its steady share is α·U·R_se.
+    its steady share is α·U·R_se. The data identify that share, not α·U: R_se is a sheltered
+    facade's film (``R_SE_SHELTERED``, the most an outside film passes in), so the α·U fitted is
+    the least the share can mean, and the plausibility checks reject only what no envelope could
+    pass.
     """
     effect = "opaque_solar_gains"
     if not ctx.building.walls:
@@ -307,7 +317,7 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
             net.add_parameter(Parameter(name, "W/(m²K)", 0.0, upper, meaning))
             params.append(name)
         signal = solar_orientation_signal(SOLAR_OPAQUE, key)
-        net.add_heat_input(signal, node, name, factor=R_SE / share)
+        net.add_heat_input(signal, node, name, factor=R_SE_SHELTERED / share)
         inputs.append((signal, node))
     detail = {
         "orientations": {

@@ -124,13 +124,7 @@ def judge(
     delta_bic = ic_after["bic"] - ic_before["bic"]
     new = {p: fit.params[p] for p in ext.new_parameters}
     bounds = [p for p in fit.at_bounds if p in ext.new_parameters]
-    # Idle: every new parameter whose neutral value is its lower bound (a gain, a capacity) sits
-    # there, so whatever the refit improved came from re-fitting the old parameters.
-    lower = {p: ext.network.parameters[p].lower for p in ext.neutral}
-    gains = [p for p, v in ext.neutral.items() if v == lower[p]]
-    idle = bool(gains) and all(
-        np.isclose(fit.params[p], lower[p], rtol=1e-3, atol=1e-9) for p in gains
-    )
+    idle = is_idle(ext, fit.params)
     gain = before - after
     checks = [
         (
@@ -174,6 +168,14 @@ def judge(
         detail=detail,
         fit=fit,
     )
+
+
+def is_idle(ext: Extension, params: dict[str, float]) -> bool:
+    """Whether every new parameter whose neutral value is its lower bound (a gain, a capacity)
+    sits there: whatever the refit improved then came from re-fitting the old parameters."""
+    lower = {p: ext.network.parameters[p].lower for p in ext.neutral}
+    gains = [p for p, v in ext.neutral.items() if v == lower[p]]
+    return bool(gains) and all(np.isclose(params[p], lower[p], rtol=1e-3, atol=1e-9) for p in gains)
 
 
 def confirm_on_folds(

@@ -34,6 +34,8 @@ from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
 from rcengine.diagnose.day_ahead import day_ahead_block
 from rcengine.diagnose.declared import with_declared_glazing
+from rcengine.diagnose.excess_sun import EFFECT as EXCESS_SUN_EFFECT
+from rcengine.diagnose.excess_sun import JUDGED_AFTER, attribute_excess_sun, has_glazing_g
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -171,6 +173,8 @@ def _diagnose(
         _repair(problem, state)
     _select(problem, state)
     _backward(problem, state)
+    if problem.settings.excess_sun:
+        attribute_excess_sun(problem, state, _context(problem, state.current))
     findings = state.findings(locate["train"]["summary"])
     whiteness = {
         "baseline": ljung_box(baseline.innovations_test, baseline.split.test.times),
@@ -366,6 +370,9 @@ def _extensions(problem: Problem, state: Selection) -> list[Extension]:
     taken = {f.effect for f in state.accepted}
     out = []
     for effect in (e for e in problem.settings.effects if e not in taken):
+        if effect == EXCESS_SUN_EFFECT and _judged_after(problem, state):
+            state.skipped[effect] = JUDGED_AFTER
+            continue
         built = CANDIDATES[effect](ctx)
         if isinstance(built, Skipped):
             state.skipped.setdefault(effect, built.reason)
@@ -373,6 +380,12 @@ def _extensions(problem: Problem, state: Selection) -> list[Extension]:
             state.skipped.pop(effect, None)
             out.append(built)
     return out
+
+
+def _judged_after(problem: Problem, state: Selection) -> bool:
+    """Whether the opaque sun waits for the step after the selection (``excess_sun``): where
+    glazing is declared, its evidence is the glazing's g-value, not a margin of test error."""
+    return problem.settings.excess_sun and has_glazing_g(state.current.network)
 
 
 def _context(problem: Problem, current: Fit) -> Context:

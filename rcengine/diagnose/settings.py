@@ -51,7 +51,9 @@ class DiagnoseSettings:
     into intervals of at least this (``dataset.aggregated``): the physics of the vocabulary acts
     over hours (the sun's course, schedules, the mass's and an emitter's hours-long time
     constants), and a six-month record at a logger's 5 minutes took 74 s to judge against 18 s
-    at 30 minutes."""
+    at 30 minutes; excess_sun: a model with declared glazing has the opaque sun judged once the
+    selection has ended, from sun the glazing admits beyond glass (``excess_sun``), not in the
+    selection's rounds."""
 
     train_fraction: float = 0.5
     preset: str = "study"
@@ -73,6 +75,7 @@ class DiagnoseSettings:
     fold_preset: str | EstimatorSettings = FOLD_REFIT
     min_fold_share: float = 0.5
     min_step_s: float = 900.0
+    excess_sun: bool = True
 
     @property
     def fold_rule(self) -> FoldRule:

@@ -65,6 +65,11 @@ AIR_CHANGES: Range = (0.05, 3.0)
 # downward flow (0.17). [m²K/W]
 R_SE = 0.04
 R_SI: Range = (0.10, 0.17)
+# The outside film of a sheltered facade, at 1 m/s of wind (ISO 6946 Annex C: h_c = 4 + 4·v,
+# h_r ≈ 4.1 W/(m²K)): the most of an absorbed flux the film can send into the wall, so the least
+# α·U a fitted sol-air share α·U·R_se can mean. R_SE (4 m/s) is the design value for heat loss;
+# sunny hours are often calmer. [m²K/W]
+R_SE_SHELTERED = 0.08
 # A covering between the indoor air and the internal mass: carpet with underlay, raised-floor or
 # suspended-ceiling void; with margin for mass reached through other rooms' air. [m²K/W]
 R_COVERING_MAX = 0.8

@@ -1,0 +1,91 @@
+"""Sun the declared glazing cannot pass is the evidence for the opaque envelope's (issue 11).
+
+The small office declares its windows; its dark facades' sun is concealed. Fitted without it,
+the base model lets the windows admit more sun than glass can; held to glass, the opaque sun
+carries the rest, with the declared glazing's g-value and the walls' α·U recovered. Where the
+windows stay within glass, the opaque sun is not taken.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose.candidates import CANDIDATES, Context
+from rcengine.diagnose.declared import with_declared_glazing
+from rcengine.diagnose.excess_sun import JUDGED_AFTER, capped_bounds, declared_g
+from rcengine.models import get_model
+from rcengine.models.bounds import G_GLAZING_MAX
+from rcengine.signals import SignalOptions, prepare
+from rcengine.simulate import simulate
+from tests.synthetic import TRUTH_BASIC, weather_and_gains
+from tests.test_plausibility import SMALL
+
+GLAZING = {"g_window": 0.45, "g_window_air": 0.05, "r_window": 0.3}
+TRUTH = {**TRUTH_BASIC, "alpha_wall": 1.0, "alpha_int": 0.0, **GLAZING}
+QUICK = DiagnoseSettings(
+    evidence="split", baseline_starts=2, max_rounds=1, effects=("opaque_solar_gains",)
+)
+
+
+def _declared(frame: pd.DataFrame):
+    return with_declared_glazing(get_model("basic", SMALL, frame.columns), SMALL, "int")
+
+
+def _record(au_walls: float) -> pd.DataFrame:
+    """Eight winter weeks of the small office whose walls pass α·U = ``au_walls`` W/(m²K) of
+    their sun (sol-air), simulated by the extended network."""
+    frame = weather_and_gains(56, start="2017-01-02")
+    frame = frame.assign(q_hvac=0.05 * frame["q_hvac"])
+    for gain in ("q_occ", "q_light"):
+        frame[gain] *= SMALL.floor_area / 1050.0
+    base = _declared(frame)
+    data = prepare(frame.assign(t_in=20.0), SMALL, base.compile().input_names)
+    ctx = Context(base, SMALL, data, SignalOptions(), TRUTH, np.zeros(len(data)))
+    ext = CANDIDATES["opaque_solar_gains"](ctx)
+    compiled = ext.network.compile()
+    params = {**TRUTH, "au_opaque_walls": au_walls, "au_opaque_roof": 0.0}
+    rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
+    data = prepare(frame.assign(t_in=20.0), SMALL, compiled.input_names)
+    u = data.inputs(compiled.input_names)
+    return frame.assign(t_in=simulate(rc, u, np.full((1, 3), 19.0), data.step_s)[0])
+
+
+def test_the_glazing_is_held_to_glass_in_its_own_split_between_mass_and_air():
+    frame = weather_and_gains(7)
+    net = _declared(frame)
+    params = {**TRUTH, "g_window": 0.9, "g_window_air": 0.3}
+    g = declared_g(net, params)
+    assert g == pytest.approx(1.2)  # the basic model's mass passes all its heat to the air
+    bounds = capped_bounds(net, params, g)
+    assert bounds["g_window"][1] == pytest.approx(0.9 * G_GLAZING_MAX / 1.2)
+    assert bounds["g_window_air"][1] == pytest.approx(0.3 * G_GLAZING_MAX / 1.2)
+    others = {n: (p.lower, p.upper) for n, p in net.parameters.items() if not n.startswith("g_")}
+    assert {n: b for n, b in bounds.items() if not n.startswith("g_")} == others
+    assert declared_g(get_model("basic", SMALL, frame.columns), TRUTH_BASIC) is None
+
+
+@pytest.fixture(scope="module")
+def dark_walls():
+    return diagnose(_record(2.0), SMALL, "basic", QUICK).to_dict()
+
+
+def test_sun_beyond_glass_is_found_on_the_opaque_walls(dark_walls):
+    (finding,) = [f for f in dark_walls["findings"] if f["accepted"]]
+    assert finding["effect"] == "opaque_solar_gains"
+    excess = finding["detail"]["excess_sun"]
+    assert excess["declared_g_before"] > G_GLAZING_MAX
+    assert excess["declared_g_after"] == pytest.approx(0.5, abs=0.05)
+    assert finding["parameters"]["au_opaque_walls"] == pytest.approx(2.0, rel=0.25)
+    assert finding["reason"].startswith("accepted: the declared glazing admitted g = ")
+    assert dark_walls["verdict"].endswith("missing: opaque_solar_gains")
+    assert "opaque_solar_gains" not in dark_walls["skipped"]
+
+
+def test_windows_within_glass_leave_the_walls_alone():
+    report = diagnose(_record(0.0), SMALL, "basic", QUICK).to_dict()
+    assert report["baseline"]["parameters"]["g_window"] < G_GLAZING_MAX
+    assert not any(f["accepted"] for f in report["findings"])
+    assert report["skipped"]["opaque_solar_gains"] == JUDGED_AFTER
