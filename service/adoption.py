@@ -135,11 +135,10 @@ def calibrate_now(
         if record is None:
             return
         record.calibration_job_id = job_id
+        if note is None and follow_up:
+            note = "started when the calibration running at the change had ended"
         if note is not None:
             record.detail = {**(record.detail or {}), "calibration": note}
-        elif follow_up:
-            followed = "started when the calibration running at the change had ended"
-            record.detail = {**(record.detail or {}), "calibration": followed}
 
 
 def after_diagnosis(runner: JobRunner, job_id: int, done: Future) -> None:
@@ -170,10 +169,11 @@ def after_calibrations(runner: JobRunner, job_ids: list[int]) -> None:
         for job_id in job_ids:
             with runner.db.session() as session:
                 job = repository.get_job(session, job_id)
+                if job.status != SUCCEEDED or not (job.details or {}).get("model_changed"):
+                    continue
                 change = latest_change(session, job.building_id)
                 spec = spec_of(repository.get_building(session, job.building_id))
-            stale = job.status == SUCCEEDED and (job.details or {}).get("model_changed")
-            if stale and change is not None:
+            if change is not None:
                 calibrate_now(runner, job.building_id, Change(change, spec), follow_up=True)
     except (RCEngineError, ServiceError) as exc:
         log.warning("no follow-up calibration", extra={"job_ids": job_ids, "error": str(exc)})

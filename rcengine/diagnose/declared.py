@@ -20,6 +20,8 @@ from rcengine.columns import SOLAR_WINDOW, T_OUT
 from rcengine.models.bounds import G_GLAZING_MAX, RHO_CP_AIR, U_GLAZING
 from rcengine.network import Parameter, RCNetwork
 
+# The declared glazing's g-values: into the interior mass, and into the air directly.
+G_WINDOW, G_WINDOW_AIR = "g_window", "g_window_air"
 # Steady air leakage the glazing conductance may also carry where the model has no other direct
 # path from the air to outdoors: a leaky building's infiltration (EN 12831-1 Table B.5). [1/h]
 LEAKAGE_ACH = 1.0
@@ -49,25 +51,25 @@ def with_declared_glazing(network: RCNetwork, building: Building, mass: str) -> 
     net = network.copy(network.name)
     net.add_parameter(
         Parameter(
-            "g_window",
+            G_WINDOW,
             "-",
             0.0,
             G_GLAZING_MAX,
             f"g-value of the declared glazing ({area:g} m²): transmitted sun absorbed indoors",
         )
     )
-    net.add_heat_input(SOLAR_WINDOW, mass, "g_window")
+    net.add_heat_input(SOLAR_WINDOW, mass, G_WINDOW)
     if mass != air:
         net.add_parameter(
             Parameter(
-                "g_window_air",
+                G_WINDOW_AIR,
                 "-",
                 0.0,
                 G_GLAZING_MAX,
                 "part of the declared glazing's g-value heating the indoor air directly",
             )
         )
-        net.add_heat_input(SOLAR_WINDOW, air, "g_window_air")
+        net.add_heat_input(SOLAR_WINDOW, air, G_WINDOW_AIR)
     if T_OUT not in network.neighbours(air):
         leakage = LEAKAGE_ACH * RHO_CP_AIR * building.volume / 3600.0 / area  # [W/(m²K)]
         net.add_parameter(

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 from rcengine.columns import SOLAR_WINDOW
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped
+from rcengine.diagnose.declared import G_WINDOW, G_WINDOW_AIR, has_declared_glazing
 from rcengine.diagnose.fitting import Fit, FitJob, fit_many
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import Finding, is_idle, judge, reject_implausible
@@ -38,8 +39,7 @@ if TYPE_CHECKING:
     from rcengine.diagnose.selection import Problem, Selection
 
 EFFECT = "opaque_solar_gains"
-# Parameters of the declared glazing (``declared.with_declared_glazing``).
-DECLARED_G = ("g_window", "g_window_air")
+DECLARED_G = (G_WINDOW, G_WINDOW_AIR)
 # Why the rounds leave the opaque sun out where glazing is declared (``state.skipped``).
 JUDGED_AFTER = (
     "judged once the selection has ended, from sun the declared glazing admits beyond glass"
@@ -49,7 +49,7 @@ JUDGED_AFTER = (
 def has_glazing_g(network: RCNetwork) -> bool:
     """Whether the network takes the sun through declared glazing with a fitted g-value (the
     base model given the description's windows, ``declared``)."""
-    return SOLAR_WINDOW in network.signals and DECLARED_G[0] in network.parameters
+    return has_declared_glazing(network) and G_WINDOW in network.parameters
 
 
 def declared_g(network: RCNetwork, params: dict[str, float]) -> float | None:
@@ -102,23 +102,22 @@ def _capped_fits(problem: Problem, current: Fit, ext: Extension, g: float) -> li
     """The current model and ``ext`` refitted with the declared glazing held to glass,
     warm-started from the current fit with the glazing scaled down to glass."""
     settings = problem.settings
-    scaled = {
-        **current.params,
-        **{n: current.params[n] * G_GLAZING_MAX / g for n in DECLARED_G if n in current.params},
-    }
     models = [(current.network, current.options, {}), (ext.network, ext.signals, ext.neutral)]
-    jobs = [
-        FitJob(
-            network,
-            options,
-            problem.split(network, options),
-            settings.preset,
-            settings.random_state,
-            [{**scaled, **neutral}],
-            capped_bounds(network, current.params, g),
+    jobs = []
+    for network, options, neutral in models:
+        bounds = capped_bounds(network, current.params, g)
+        held = {n: bounds[n][1] for n in DECLARED_G if n in bounds}  # the glazing at its cap
+        jobs.append(
+            FitJob(
+                network,
+                options,
+                problem.split(network, options),
+                settings.preset,
+                settings.random_state,
+                [{**current.params, **held, **neutral}],
+                bounds,
+            )
         )
-        for network, options, neutral in models
-    ]
     return fit_many(jobs, settings.workers)
 
 
