@@ -48,7 +48,6 @@ from rcengine.diagnose.plausibility import (
     SEARCH_MARGIN,
     SKY_COUPLING,
     SKY_H_R_TYPICAL,
-    SOIL_STORAGE,
     U_FLOOR,
     UNMETERED_W_M2,
     VENTILATION_ACH,
@@ -101,14 +100,6 @@ ON_OFF_SHARE = 0.5
 # Share of an hour's rows with the heater at capacity beyond which no schedule may switch on in
 # that hour (of a day type): most of its dates hold the heater's recovery. [-]
 SATURATED_HOUR_SHARE = 0.5
-# The ground candidate's soil layer: its node, the least capacity and resistance searched (half a
-# millimetre and half a centimetre of soil at ISO 13370's 2 MJ/(m³K) and 2 W/(mK)) and where the
-# refit starts, a thin layer (5 mm of soil) under a floor left open. [J/(m²K)], [m²K/W]
-SOIL_NODE = "soil"
-SOIL_CAPACITY_MIN = 1.0e3
-SOIL_RESISTANCE_MIN = 0.0025
-SOIL_CAPACITY_NEUTRAL = 1.0e4
-SOIL_RESISTANCE_NEUTRAL = 0.05
 
 
 @dataclass(frozen=True)
@@ -634,15 +625,10 @@ def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
 def ground_coupling(ctx: Context) -> Extension | Skipped:
     """Heat exchange through the floor with the soil under it, into the interior mass.
 
-    The floor couples the mass to a soil layer that stores heat, which couples to the undisturbed
-    soil below (ISO 52016-1's virtual ground layer, its thickness fitted): q = (T_soil −
-    T_mass)/r_floor into the mass per m² of floor, with c_soil·dT_soil/dt = (T_base + ΔT −
-    T_soil)/r_soil − (T_soil − T_mass)/r_floor. T_base is the outdoor annual cycle damped and
-    lagged into the soil (``signals.ground``, signal t_ground); the soil's warming by the
-    building, ΔT, enters as the constant heat q_ground = ΔT/r_soil per m² of floor on the
-    ``unit`` signal, so the fitted ground temperature is T_base + q_ground·r_soil and the floor's
-    U-value 1/(r_floor + r_soil). Without the storage, a floor to a fixed-phase soil wave left
-    the slab's lag to the season's weather and named the soil's storage thermal mass.
+    q = U_floor·A_floor·(T_base(t) + ΔT − T_mass), with U_floor = 1/r_floor and T_base the
+    outdoor annual cycle damped and lagged into the soil (``signals.ground``, signal t_ground);
+    the soil's warming by the building, ΔT, is fitted as the constant heat q_ground = U_floor·ΔT
+    per m² of floor on the ``unit`` signal, so the fitted ground temperature is T_base + q·r.
     """
     effect = "ground_coupling"
     if T_GROUND in ctx.network.signals:
@@ -650,31 +636,13 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
     target = mass_node(net)
-    floor_r = (1.0 / (SEARCH_MARGIN * U_FLOOR[1]), SEARCH_MARGIN / U_FLOOR[0])
     net.add_parameter(
         Parameter(
             "r_floor",
             "m²K/W",
-            *floor_r,
-            "resistance between the floor/interior mass and the soil layer, per floor area",
-        )
-    )
-    net.add_parameter(
-        Parameter(
-            "c_soil",
-            "J/(K·m²)",
-            SOIL_CAPACITY_MIN,
-            SEARCH_MARGIN * SOIL_STORAGE[1],
-            "heat capacity of the soil layer under the floor, per floor area",
-        )
-    )
-    net.add_parameter(
-        Parameter(
-            "r_soil",
-            "m²K/W",
-            SOIL_RESISTANCE_MIN,
-            floor_r[1],
-            "resistance between the soil layer and the undisturbed soil, per floor area",
+            1.0 / (SEARCH_MARGIN * U_FLOOR[1]),
+            SEARCH_MARGIN / U_FLOOR[0],
+            "resistance between the floor/interior mass and the soil, per floor area (1/U)",
         )
     )
     net.add_parameter(
@@ -683,27 +651,18 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
             "W/m²",
             -20.0,
             60.0,
-            "constant heat from the soil's warming by the building, ΔT/r_soil, per floor area",
+            "constant heat from the soil's warming by the building, U·ΔT, per floor area",
         )
     )
-    net.add_capacitor(SOIL_NODE, "c_soil", factor=floor)
-    net.add_resistor(target, SOIL_NODE, "r_floor", factor=1.0 / floor)
-    net.add_resistor(T_GROUND, SOIL_NODE, "r_soil", factor=1.0 / floor)
-    net.add_heat_input(UNIT, SOIL_NODE, "q_ground", factor=floor)
+    net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / floor)
+    net.add_heat_input(UNIT, target, "q_ground", factor=floor)
     return Extension(
         effect,
         net,
         ctx.signals,
-        ("r_floor", "c_soil", "r_soil", "q_ground"),
-        structural=True,
-        # A floor open at the weakest U searched to a thin, nearly massless layer: the earlier
-        # candidate without storage, from which the refit grows the layer.
-        neutral={
-            "r_floor": floor_r[1],
-            "c_soil": SOIL_CAPACITY_NEUTRAL,
-            "r_soil": SOIL_RESISTANCE_NEUTRAL,
-            "q_ground": 0.0,
-        },
+        ("r_floor", "q_ground"),
+        ((T_GROUND, target), (UNIT, target)),
+        neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
         absent={"r_floor": np.inf, "q_ground": 0.0},
         detail={"node": target, "floor_area_m2": floor, **_ground_temperatures(ctx)},
     )

@@ -20,8 +20,6 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from rcengine.columns import (
     Q_HVAC,
     SKY_DELTA,
@@ -39,7 +37,7 @@ from rcengine.models.bounds import (
     U_OPAQUE,
 )
 from rcengine.models.physical import solar_apertures, steady_state_gains, ua
-from rcengine.signals.ground import ESTIMATE_Z, YEAR_S
+from rcengine.signals.ground import ESTIMATE_Z
 
 if TYPE_CHECKING:
     from rcengine.diagnose.candidates import Extension
@@ -87,11 +85,6 @@ U_FLOOR: Range = (0.05, U_GROUND_MAX)
 # the annual mean's own error, read from a few months of weather, is added to it
 # (``annual_mean_uncertainty``). [K]
 GROUND_TEMPERATURE_MARGIN_K = 2.0
-# The soil a floor can draw on over a heating season: the layer within the annual wave's
-# periodic penetration depth δ, ρc·δ = √(λ·ρc·P/π): 6.3 MJ/(m²K) in sand or gravel, 6.7 in clay
-# and 8.4 in rock (ISO 13370:2017 Table 7: λ 2.0, 1.5, 3.5 W/(mK); ρc 2.0, 3.0, 2.0 MJ/(m³K)), the
-# most of rock. [J/(m²K)]
-SOIL_STORAGE: Range = (0.0, float(np.sqrt(3.5 * 2.0e6 * YEAR_S / np.pi)))
 # Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
 # −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
 STEFAN_BOLTZMANN = 5.670e-8
@@ -330,28 +323,19 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Floor U-value 1/(r_floor + r_soil), the soil layer's capacity and the fitted mean ground
-    temperature: the undisturbed soil's T_base raised by q_ground·r_soil (the constant heat
-    q_ground is (T_g − T_base)/r_soil)."""
+    """Floor U-value 1/r_floor and the fitted mean ground temperature: the undisturbed soil's
+    T_base raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base))."""
     d = ext.detail
-    t_ground = d["ground_base_c"] + params["q_ground"] * params["r_soil"]
+    r = params["r_floor"]
+    t_ground = d["ground_base_c"] + params["q_ground"] * r
     low = (
         min(d["ground_base_c"], d["outdoor_mean_c"])
         - GROUND_TEMPERATURE_MARGIN_K
         - ESTIMATE_Z * d["outdoor_mean_se_k"]
     )
     high = d["indoor_mean_c"] + GROUND_TEMPERATURE_MARGIN_K
-    u_floor = 1.0 / (params["r_floor"] + params["r_soil"])
     return [
-        Reading("u_floor", u_floor, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),
-        Reading(
-            "c_soil",
-            params["c_soil"],
-            "J/(m²K)",
-            "heat capacity of the soil layer under the floor",
-            SOIL_STORAGE,
-            "soil within the annual wave's depth",
-        ),
+        Reading("u_floor", 1.0 / r, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),
         Reading(
             "t_ground",
             t_ground,
