@@ -511,6 +511,7 @@ SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed_12": SEALED_SEED + 27,
     "testbed_sealed_13": SEALED_SEED + 28,
     "testbed_sealed_14": SEALED_SEED + 29,
+    "testbed_sealed_15": SEALED_SEED + 37,
 }
 SEALED_SETS: dict[str, tuple[Case, ...]] = {
     name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
