@@ -78,8 +78,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 @asynccontextmanager
 async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     settings: Settings = app.state.settings
-    if settings.sqlite_path is not None:
-        settings.sqlite_path.parent.mkdir(parents=True, exist_ok=True)
+    folder = settings.sqlite_path.parent if settings.sqlite_path is not None else None
+    if folder is not None and not folder.exists():
+        # The embedded default lives in a folder of its own; say so when it is made, so a
+        # mistyped RCSERVICE_DATABASE_URL shows in the log instead of an empty service.
+        folder.mkdir(parents=True)
+        log.warning("created the database folder", extra={"folder": str(folder)})
     db = Database(settings.database_url)
     db.migrate()
     admin_hash = admin_token_hash(settings, db)

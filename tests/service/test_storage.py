@@ -282,3 +282,24 @@ def test_schema_and_upsert_compile_for_postgresql():
         "ON CONFLICT (building_id, time) DO UPDATE SET "
         "t_in = coalesce(excluded.t_in, measurements.t_in)" in upsert
     )
+
+
+def test_a_missing_database_folder_is_made_and_said(tmp_path, caplog):
+    """The embedded database's folder is created at start-up, and the log says so: a mistyped
+    RCSERVICE_DATABASE_URL shows there instead of as an empty service."""
+    from fastapi.testclient import TestClient
+
+    from service.main import create_app
+
+    from .conftest import app_settings
+
+    folder = tmp_path / "not" / "yet"
+    settings = app_settings(f"sqlite:///{folder / 'rcservice.db'}")
+    with caplog.at_level("WARNING", logger="service.main"), TestClient(create_app(settings)):
+        assert (folder / "rcservice.db").exists()
+    (made,) = [r for r in caplog.records if r.getMessage() == "created the database folder"]
+    assert made.folder == str(folder)
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="service.main"), TestClient(create_app(settings)):
+        pass
+    assert not [r for r in caplog.records if r.getMessage() == "created the database folder"]
