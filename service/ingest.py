@@ -130,7 +130,7 @@ def remove(db: Database, building_id: int, start: pd.Timestamp, end: pd.Timestam
             session, building_id, bridge.to_datetime(start), bridge.to_datetime(end)
         )
         building.last_measured_at = repository.last_measured_time(session, building_id)
-        if not repository.building_summary(session, building_id).rows:
+        if not repository.has_measurements(session, building_id):
             building.grid_origin = None
             building.step_s = None
         revision = repository.next_data_revision(session, building_id)

@@ -187,6 +187,12 @@ def delete_measurements(session: Session, building_id: int, start: datetime, end
     return session.execute(query).rowcount
 
 
+def has_measurements(session: Session, building_id: int) -> bool:
+    """Whether the building stores any row at all (measured or weather only)."""
+    query = select(measurements.c.building_id).where(measurements.c.building_id == building_id)
+    return session.scalar(select(query.exists())) is True
+
+
 def last_measured_time(session: Session, building_id: int) -> datetime | None:
     """The latest stored time with a measured t_in."""
     query = select(func.max(measurements.c[TIME])).where(
