@@ -13,6 +13,7 @@ import pytest
 from alembic import command
 from alembic.autogenerate import compare_metadata
 from alembic.migration import MigrationContext
+from fastapi.testclient import TestClient
 from sqlalchemy import String, Text, insert, text
 from sqlalchemy.dialects import postgresql
 from sqlalchemy.exc import IntegrityError, StatementError
@@ -23,10 +24,11 @@ from service.cli import app as cli
 from service.core.config import Settings
 from service.core.db import Database, alembic_config
 from service.jobs import JobRunner
+from service.main import create_app
 from service.models import Base, JobRecord, ParameterSetRecord
 from service.scheduler import JOB_ID, start_scheduler
 
-from .conftest import json_rows, register
+from .conftest import app_settings, json_rows, register
 
 # Storage, API and job tests run on SQLite and on a real PostgreSQL server (conftest).
 ON_BOTH_DATABASES = True
@@ -287,19 +289,17 @@ def test_schema_and_upsert_compile_for_postgresql():
 def test_a_missing_database_folder_is_made_and_said(tmp_path, caplog):
     """The embedded database's folder is created at start-up, and the log says so: a mistyped
     RCSERVICE_DATABASE_URL shows there instead of as an empty service."""
-    from fastapi.testclient import TestClient
-
-    from service.main import create_app
-
-    from .conftest import app_settings
-
     folder = tmp_path / "not" / "yet"
     settings = app_settings(f"sqlite:///{folder / 'rcservice.db'}")
+
+    def made() -> list:
+        return [r for r in caplog.records if r.getMessage() == "created the database folder"]
+
     with caplog.at_level("WARNING", logger="service.main"), TestClient(create_app(settings)):
         assert (folder / "rcservice.db").exists()
-    (made,) = [r for r in caplog.records if r.getMessage() == "created the database folder"]
-    assert made.folder == str(folder)
+    (record,) = made()
+    assert record.folder == str(folder)
     caplog.clear()
     with caplog.at_level("WARNING", logger="service.main"), TestClient(create_app(settings)):
         pass
-    assert not [r for r in caplog.records if r.getMessage() == "created the database folder"]
+    assert not made()
