@@ -6,11 +6,11 @@ import pytest
 
 import rcengine.signals.derived
 from rcengine.building import Building
-from rcengine.columns import VENT_LOSS, VENT_SCHEDULE, WIND_LOSS, schedule_signal_name
+from rcengine.columns import T_GROUND, VENT_LOSS, VENT_SCHEDULE, WIND_LOSS, schedule_signal_name
 from rcengine.exceptions import ModelError
 from rcengine.io.timeseries import read_timeseries
 from rcengine.signals.derived import SignalOptions, derive, derivers, mask_measured
-from rcengine.signals.ground import ground_temperature
+from rcengine.signals.ground import YEAR_S, ground_depth, ground_temperature
 from rcengine.signals.schedules import (
     clock_zone,
     closed_weekdays,
@@ -161,6 +161,26 @@ def test_stored_options_without_a_sky_model_keep_swinbank():
     assert SignalOptions.from_stored({"sky_model": "perez"}).sky_emissivity == "swinbank"
     stored = SignalOptions(sky_emissivity="clark_allen").to_dict()
     assert SignalOptions.from_stored(stored) == SignalOptions()
+
+
+def test_t_ground_reads_the_soil_at_the_stored_depth(project_data):
+    """A model stored before the depth was a setting was fitted to the wave a month deep (1.66 m)
+    and keeps it; one fitted a month and a half deep is served that wave, damped further."""
+    building = Building.from_json(project_data / "energyplus" / "office" / "building.json")
+    times = pd.date_range("2017-01-01", "2017-12-31 23:00", freq="h", tz="UTC")
+    coldest = pd.Timestamp("2017-01-16", tz="UTC")
+    phase = 2 * np.pi * (times - coldest).total_seconds().to_numpy() / YEAR_S
+    frame = pd.DataFrame({"t_out": 12.0 - 9.0 * np.cos(phase)}, index=times)
+    old = SignalOptions.from_stored({"sky_model": "isotropic"})
+    assert old.ground_depth_m == pytest.approx(1.66, abs=0.005)
+    deeper = SignalOptions(ground_depth_m=ground_depth(YEAR_S / 8))
+    assert SignalOptions.from_stored(deeper.to_dict()) == deeper
+    swing = {
+        lag: np.ptp(derive(frame, building, [T_GROUND], options)[T_GROUND]) / 2.0
+        for lag, options in ((12, old), (8, deeper))
+    }
+    assert swing[12] == pytest.approx(9.0 * np.exp(-2 * np.pi / 12), abs=0.01)
+    assert swing[8] == pytest.approx(9.0 * np.exp(-2 * np.pi / 8), abs=0.01)
 
 
 def test_a_cloud_cover_column_drives_the_sky_where_it_has_values(project_data):

@@ -290,3 +290,21 @@ def test_a_test_period_after_a_gap_in_the_record_is_restarted_from_its_own_first
     simulated = carried_on(network.compile(), TRUTH_BASIC, split)
     assert np.isfinite(simulated).all()
     assert np.max(np.abs(simulated - split.test.measured)) < 0.02
+
+
+def test_the_soil_s_lag_is_the_version_the_evidence_takes():
+    """The ground read a month deep and a month and a half deep are two versions of one effect:
+    the one the folds accept is taken, and the other's lag and fate are named."""
+    month, month_and_a_half = (_version("ground_coupling", "", 1.0, 0.8) for _ in range(2))
+    for version, lag in ((month, 1.0), (month_and_a_half, 1.5)):
+        version.detail = {"ground_lag_months": lag}
+    month_and_a_half.accepted, month_and_a_half.evidence = False, None
+    month_and_a_half.reason = "rejected as implausible: U-value of the ground floor: 2.27 W/(m²K)"
+    assert _one_version_each([month_and_a_half, month]) == [month]
+    assert month.detail["ground_lag_not_taken"] == (
+        "1.5 months (rejected as implausible: U-value of the ground floor: 2.27 W/(m²K))"
+    )
+    deeper = _version("ground_coupling", "", 1.0, 0.6)
+    deeper.detail = {"ground_lag_months": 1.5}
+    assert _one_version_each([month, deeper]) == [deeper]
+    assert deeper.detail["ground_lag_not_taken"] == "1.0 months (0.800 K pooled over the folds)"

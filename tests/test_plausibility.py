@@ -383,6 +383,22 @@ def test_seasonal_ground_temperature_by_hand():
     assert annual_cycle(times, -t_out, -33.9).amplitude == pytest.approx(9.0, abs=0.01)
 
 
+def test_the_ground_candidate_reads_the_soil_at_both_ends_of_iso_13370_s_lags(gain_context):
+    """A month's lag by default, a month and a half (an insulated floor) as its alternative: the
+    same parameters, the soil read 1.66 and 2.49 m deep, each judged against its own soil."""
+    ground = CANDIDATES["ground_coupling"](gain_context)
+    (deeper,) = ground.alternatives
+    assert ground.signals.ground_depth_m == pytest.approx(1.66, abs=0.005)
+    assert deeper.signals.ground_depth_m == pytest.approx(2.49, abs=0.005)
+    assert ground.detail["ground_lag_months"] == pytest.approx(1.0)
+    assert deeper.detail["ground_lag_months"] == pytest.approx(1.5)
+    assert deeper.new_parameters == ground.new_parameters and not deeper.alternatives
+    times, t_out = gain_context.data.times, gain_context.train["t_out"].to_numpy(dtype=float)
+    for version in (ground, deeper):
+        soil = seasonal_ground_temperature(times, t_out, 45.07, version.signals.ground_depth_m)
+        assert version.detail["ground_base_c"] == pytest.approx(np.mean(soil))
+
+
 def test_the_annual_mean_s_standard_error_covers_the_weather_of_a_season():
     """Four months of a known cycle (mean 10 °C, swing 12 K) under day-to-day weather that
     persists (AR(1) daily anomalies, ρ = 0.7, σ = 4 K) and a daily swing: over 200 seasons the

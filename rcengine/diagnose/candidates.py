@@ -72,8 +72,11 @@ from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.derived import indoor_operating_point
 from rcengine.signals.ground import (
+    GROUND_LAGS_S,
+    SOIL_PENETRATION_DEPTH_M,
     annual_cycle,
     annual_mean_uncertainty,
+    ground_depth,
     seasonal_ground_temperature,
 )
 from rcengine.signals.schedules import (
@@ -124,6 +127,9 @@ class Extension:
     absent: dict[str, float] | None = None
     # Facts an explanation quotes and ``plausibility.assess`` reads (areas, volume, temperatures).
     detail: dict = field(default_factory=dict)
+    # Other versions of the same physics with the same parameters (the soil read at another lag),
+    # each refitted beside it and judged as a version of one effect (``selection._versions``).
+    alternatives: tuple[Extension, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -629,10 +635,22 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     outdoor annual cycle damped and lagged into the soil (``signals.ground``, signal t_ground);
     the soil's warming by the building, ΔT, is fitted as the constant heat q_ground = U_floor·ΔT
     per m² of floor on the ``unit`` signal, so the fitted ground temperature is T_base + q·r.
+    The lag depends on the floor's insulation, which the building description does not give:
+    the soil is read at the model's lag (a month by default), and at ISO 13370's other lags
+    (``GROUND_LAGS_S``) as alternatives.
     """
     effect = "ground_coupling"
     if T_GROUND in ctx.network.signals:
         return Skipped(effect, "the model already has ground coupling")
+    own = ctx.signals.ground_depth_m
+    others = [ground_depth(lag) for lag in GROUND_LAGS_S if not np.isclose(ground_depth(lag), own)]
+    alternatives = tuple(_ground_at(ctx, replace(ctx.signals, ground_depth_m=z)) for z in others)
+    return replace(_ground_at(ctx, ctx.signals), alternatives=alternatives)
+
+
+def _ground_at(ctx: Context, signals: SignalOptions) -> Extension:
+    """``ground_coupling`` with the soil read at ``signals.ground_depth_m``."""
+    effect = "ground_coupling"
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
     target = mass_node(net)
@@ -656,26 +674,33 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     )
     net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / floor)
     net.add_heat_input(UNIT, target, "q_ground", factor=floor)
+    depth = signals.ground_depth_m
     return Extension(
         effect,
         net,
-        ctx.signals,
+        signals,
         ("r_floor", "q_ground"),
         ((T_GROUND, target), (UNIT, target)),
         neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
         absent={"r_floor": np.inf, "q_ground": 0.0},
-        detail={"node": target, "floor_area_m2": floor, **_ground_temperatures(ctx)},
+        detail={
+            "node": target,
+            "floor_area_m2": floor,
+            "ground_depth_m": depth,
+            "ground_lag_months": 12.0 * depth / (2.0 * np.pi * SOIL_PENETRATION_DEPTH_M),
+            **_ground_temperatures(ctx, depth),
+        },
     )
 
 
-def _ground_temperatures(ctx: Context) -> dict[str, float]:
+def _ground_temperatures(ctx: Context, depth_m: float) -> dict[str, float]:
     """What the fitted ground temperature is judged against, over the training period [°C]: the
-    mean of T_base, the outdoor annual mean (with its standard error [K]) and the mean indoor
-    temperature."""
+    mean of T_base read ``depth_m`` deep, the outdoor annual mean (with its standard error [K])
+    and the mean indoor temperature."""
     times, t_out = ctx.data.times, ctx.train[T_OUT].to_numpy(dtype=float)
     latitude = ctx.building.location.latitude
     cycle = annual_cycle(times, t_out, latitude)
-    base = seasonal_ground_temperature(times, t_out, latitude, cycle=cycle)
+    base = seasonal_ground_temperature(times, t_out, latitude, depth_m, cycle)
     return {
         "ground_base_c": float(np.mean(base)),
         "outdoor_mean_c": float(cycle.mean),

@@ -324,7 +324,8 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """Floor U-value 1/r_floor and the fitted mean ground temperature: the undisturbed soil's
-    T_base raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base))."""
+    T_base raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base)); the lag
+    of the soil it was read at, reported only."""
     d = ext.detail
     r = params["r_floor"]
     t_ground = d["ground_base_c"] + params["q_ground"] * r
@@ -343,6 +344,13 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             "mean ground temperature under the floor over the training period",
             (low, high),
             "soil between the undisturbed soil and the indoor air",
+        ),
+        Reading(
+            "ground_lag",
+            d["ground_lag_months"],
+            "months",
+            "lag of the soil's annual wave behind the outdoor air's (1: a lightly insulated "
+            "slab, 1.5: an insulated floor)",
         ),
     ]
 

@@ -312,20 +312,27 @@ def _judge(
 def _refits(
     problem: Problem, current: Fit, extensions: list[Extension], splits: dict[str, Split]
 ) -> list[Fit]:
-    """Each extension refitted on the training period, started from the current parameters
-    with the extension neutral and as they are."""
+    """Each extension refitted on the training period (``_fit_from_current``)."""
+    return _fit_from_current(problem, current, extensions, [splits[e.effect] for e in extensions])
+
+
+def _fit_from_current(
+    problem: Problem, current: Fit, extensions: list[Extension], splits: list[Split]
+) -> list[Fit]:
+    """Each extension fitted on its split's training period, started from the current
+    parameters with the extension neutral and as they are."""
     settings = problem.settings
     return fit_many(
         [
             FitJob(
                 e.network,
                 e.signals,
-                splits[e.effect],
+                split,
                 settings.structural_preset if e.structural else settings.preset,
                 settings.random_state,
                 [{**current.params, **e.neutral}, dict(current.params)],
             )
-            for e in extensions
+            for e, split in zip(extensions, splits, strict=True)
         ],
         settings.workers,
     )
@@ -448,16 +455,31 @@ def _refine(
     return [(i, refined, fit) for (i, refined), fit in zip(where, refits, strict=True)]
 
 
+def _alternatives(
+    problem: Problem, current: Fit, extensions: list[Extension]
+) -> list[tuple[int, Extension, Fit]]:
+    """Each extension's alternatives (``Extension.alternatives``: the same parameters, another
+    reading of its input), refitted from the same starts as the first version (``_refits``), so
+    that each version is the fit it would be alone; as (index of the first version, alternative,
+    fit)."""
+    where = [(i, alt) for i, ext in enumerate(extensions) for alt in ext.alternatives]
+    alternatives = [alt for _, alt in where]
+    splits = [problem.split(alt.network, alt.signals) for alt in alternatives]
+    refits = _fit_from_current(problem, current, alternatives, splits) if where else []
+    return [(i, alt, fit) for (i, alt), fit in zip(where, refits, strict=True)]
+
+
 def _versions(
     problem: Problem, extensions: list[Extension], fits: list[Fit], refined: list[tuple]
 ) -> list[tuple[Extension, Fit]]:
-    """The versions of each extension to judge: with folds, the first and the refined one (the
-    folds choose, ``_one_version_each``); without, the one that fits the training period better."""
+    """The versions of each extension to judge: with folds, the first and the refined or
+    alternative ones (the folds choose, ``_one_version_each``); without, the one that fits the
+    training period best."""
     versions = list(zip(extensions, fits, strict=True))
     for i, ext, fit in refined:
         if problem.folds:
             versions.append((ext, fit))
-        elif fit.sse_train < fits[i].sse_train:
+        elif fit.sse_train < versions[i][1].sse_train:
             versions[i] = (ext, fit)
     return versions
 
@@ -480,8 +502,18 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
         if worse.evidence is not None and "schedule" in worse.detail:
             pooled = worse.evidence.pooled_after
             best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+        if "ground_lag_months" in worse.detail:
+            lag, how = worse.detail["ground_lag_months"], _version_words(worse)
+            best.detail["ground_lag_not_taken"] = f"{lag:.1f} months ({how})"
         chosen[f.effect] = best
     return list(chosen.values())
+
+
+def _version_words(f: Finding) -> str:
+    """How a version not taken fared: its pooled test RMSE over the folds, else its verdict."""
+    if f.evidence is not None:
+        return f"{f.evidence.pooled_after:.3f} K pooled over the folds"
+    return "accepted" if f.accepted else (f.reason or "rejected")
 
 
 def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> Finding | None:
@@ -504,7 +536,8 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     refit = ranked[:n_refit]
     problem.say(f"  refitting {', '.join(e.effect for e in refit)}")
     fits = _refits(problem, current, refit, splits)
-    versions = _versions(problem, refit, fits, _refine(problem, current, refit, fits))
+    others = _refine(problem, current, refit, fits) + _alternatives(problem, current, refit)
+    versions = _versions(problem, refit, fits, others)
     confirmed = [
         _judge(problem, e, current, fit, screens[e.effect], round_no) for e, fit in versions
     ]

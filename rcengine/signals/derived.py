@@ -31,7 +31,11 @@ from rcengine.columns import (
 )
 from rcengine.dataset import Dataset
 from rcengine.exceptions import ModelError
-from rcengine.signals.ground import AnnualCycle, seasonal_ground_temperature
+from rcengine.signals.ground import (
+    GROUND_DEPTH_M,
+    AnnualCycle,
+    seasonal_ground_temperature,
+)
 from rcengine.signals.schedules import Zone, clock_zone, closed_weekdays, schedule_signal
 from rcengine.signals.solar import solar_gains, solar_signal_names
 
@@ -56,7 +60,9 @@ class SignalOptions:
     "clark_allen" or "swinbank", which parameter sets stored before it existed keep,
     ``from_stored``); cloud_cover: where ``sky_delta``'s cloud cover comes from, "estimated"
     (from ``ghi``) or "column" (the data's ``cloud_cover``, which a forecast's future rows then
-    need too; ``for_columns`` chooses it when the fitted data have the column).
+    need too; ``for_columns`` chooses it when the fitted data have the column); ground_depth_m:
+    how deep into the soil ``t_ground`` reads the annual cycle (``signals.ground``; a month's
+    lag, which parameter sets stored before it existed were fitted with). [m]
     """
 
     sky_model: str = "isotropic"
@@ -69,6 +75,7 @@ class SignalOptions:
     input_hold: str = "zoh"
     sky_emissivity: str = "clark_allen"
     cloud_cover: str = "estimated"
+    ground_depth_m: float = GROUND_DEPTH_M
 
     @classmethod
     def for_columns(cls, columns: Iterable[str], **options: Any) -> SignalOptions:
@@ -174,7 +181,9 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
     cycle = None if options.ground_cycle is None else AnnualCycle.from_dict(options.ground_cycle)
     return pd.DataFrame(
         {
-            T_GROUND: seasonal_ground_temperature(frame.index, t_out, latitude, cycle=cycle),
+            T_GROUND: seasonal_ground_temperature(
+                frame.index, t_out, latitude, options.ground_depth_m, cycle
+            ),
             UNIT: np.ones(len(frame)),
         },
         index=frame.index,

@@ -35,12 +35,25 @@ SOIL_HEAT_CAPACITY = 2.0e6
 # Periodic penetration depth of the annual wave, δ = √(λ·P/(π·ρc)) (ISO 13370:2017 Table 7:
 # 3.2 m in sand or gravel; 2.2 m in clay, 4.2 m in rock). [m]
 SOIL_PENETRATION_DEPTH_M = float(np.sqrt(SOIL_CONDUCTIVITY * YEAR_S / (np.pi * SOIL_HEAT_CAPACITY)))
-# Lag of a slab floor's ground heat flow behind the outdoor annual cycle: about a month (the phase
-# shift β of ISO 13370's periodic method for slab-on-ground floors, 0.7–1 month). [s]
+# Lag of a slab floor's ground heat flow behind the outdoor annual cycle. ISO 13370:2017's
+# external phase shift for a slab on the ground, β = 1.5 − 0.42·ln(δ/d_t + 1) months (d_t: the
+# floor's total equivalent thickness w + λ·(R_si + R_f + R_se)), runs from 0.8 months under a
+# bare slab (d_t ≈ 0.7 m) through 1 month (d_t ≈ 1.4 m: a little insulation, or a slab on fill)
+# and 1.3 months with 2 m²K/W of insulation to 1.5 in the limit of an insulated floor. The floor's
+# construction is not in the building description: a month is the default, and the diagnosis
+# tries the insulated end too (``GROUND_LAGS_S``). [s]
 GROUND_LAG_S = YEAR_S / 12.0
-# The depth at which the annual wave lags by GROUND_LAG_S, z = δ·2π·lag/year (≈ 1.7 m; its swing
-# there is damped to e^(−z/δ) ≈ 0.59). [m]
-GROUND_DEPTH_M = SOIL_PENETRATION_DEPTH_M * 2.0 * np.pi * GROUND_LAG_S / YEAR_S
+INSULATED_GROUND_LAG_S = YEAR_S / 8.0
+GROUND_LAGS_S = (GROUND_LAG_S, INSULATED_GROUND_LAG_S)
+
+
+def ground_depth(lag_s: float) -> float:
+    """The depth at which the annual wave lags by ``lag_s``, z = δ·2π·lag/year (a month: 1.66 m,
+    its swing damped to e^(−z/δ) ≈ 0.59; a month and a half: 2.49 m, 0.46). [m]"""
+    return SOIL_PENETRATION_DEPTH_M * 2.0 * np.pi * lag_s / YEAR_S
+
+
+GROUND_DEPTH_M = ground_depth(GROUND_LAG_S)
 # Coldest day of the outdoor annual cycle: about 25 days after the winter solstice in mid-latitude
 # climates (day of year, northern hemisphere; half a year later in the southern). [d]
 COLDEST_DAY_OF_YEAR = 15.0
