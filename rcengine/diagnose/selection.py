@@ -470,23 +470,17 @@ def _alternatives(
 
 
 def _versions(
-    problem: Problem, extensions: list[Extension], fits: list[Fit], refined: list[tuple]
+    extensions: list[Extension], fits: list[Fit], others: list[tuple]
 ) -> list[tuple[Extension, Fit]]:
-    """The versions of each extension to judge: with folds, the first and the refined or
-    alternative ones (the folds choose, ``_one_version_each``); without, the one that fits the
-    training period best."""
-    versions = list(zip(extensions, fits, strict=True))
-    for i, ext, fit in refined:
-        if problem.folds:
-            versions.append((ext, fit))
-        elif fit.sse_train < versions[i][1].sse_train:
-            versions[i] = (ext, fit)
-    return versions
+    """The versions of each extension to judge: the first, and the refined or alternative ones
+    (``_one_version_each`` chooses among them once they are judged)."""
+    return list(zip(extensions, fits, strict=True)) + [(ext, fit) for _, ext, fit in others]
 
 
 def _one_version_each(findings: list[Finding]) -> list[Finding]:
-    """Per effect, the version the folds favour: accepted before rejected, then the lower pooled
-    test RMSE across the folds, then the better training fit; the other is named in its detail."""
+    """Per effect, the version the evidence favours: accepted before rejected, then the lower
+    pooled test RMSE across the folds (where they judge), then the better training fit; the other
+    is named in its detail."""
 
     def rank(f: Finding) -> tuple[bool, float, float]:
         pooled = f.evidence.pooled_after if f.evidence is not None else float("inf")
@@ -537,13 +531,13 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     problem.say(f"  refitting {', '.join(e.effect for e in refit)}")
     fits = _refits(problem, current, refit, splits)
     others = _refine(problem, current, refit, fits) + _alternatives(problem, current, refit)
-    versions = _versions(problem, refit, fits, others)
+    versions = _versions(refit, fits, others)
     confirmed = [
         _judge(problem, e, current, fit, screens[e.effect], round_no) for e, fit in versions
     ]
     if problem.folds:
         _confirm_on_folds(problem, state, [e for e, _ in versions], confirmed)
-        confirmed = _one_version_each(confirmed)
+    confirmed = _one_version_each(confirmed)
     for ext in ranked[n_refit:]:
         state.verdicts[ext.effect] = screened_only(ext, current, screens[ext.effect], round_no)
     for finding in confirmed:
