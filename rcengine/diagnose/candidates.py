@@ -73,10 +73,11 @@ from rcengine.signals import SignalOptions
 from rcengine.signals.derived import indoor_operating_point
 from rcengine.signals.ground import (
     GROUND_LAGS_S,
-    SOIL_PENETRATION_DEPTH_M,
+    YEAR_S,
     annual_cycle,
     annual_mean_uncertainty,
     ground_depth,
+    ground_lag,
     seasonal_ground_temperature,
 )
 from rcengine.signals.schedules import (
@@ -643,13 +644,18 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     if T_GROUND in ctx.network.signals:
         return Skipped(effect, "the model already has ground coupling")
     own = ctx.signals.ground_depth_m
-    others = [ground_depth(lag) for lag in GROUND_LAGS_S if not np.isclose(ground_depth(lag), own)]
-    alternatives = tuple(_ground_at(ctx, replace(ctx.signals, ground_depth_m=z)) for z in others)
-    return replace(_ground_at(ctx, ctx.signals), alternatives=alternatives)
+    depths = [ground_depth(lag) for lag in GROUND_LAGS_S]
+    depths = [own, *(z for z in depths if not np.isclose(z, own))]
+    first, *others = (
+        _ground_at(ctx, replace(ctx.signals, ground_depth_m=z), soil)
+        for z, soil in zip(depths, _ground_temperatures(ctx, depths), strict=True)
+    )
+    return replace(first, alternatives=tuple(others))
 
 
-def _ground_at(ctx: Context, signals: SignalOptions) -> Extension:
-    """``ground_coupling`` with the soil read at ``signals.ground_depth_m``."""
+def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> Extension:
+    """``ground_coupling`` with the soil read at ``signals.ground_depth_m``, judged against
+    ``soil`` (``_ground_temperatures`` at that depth)."""
     effect = "ground_coupling"
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
@@ -674,7 +680,6 @@ def _ground_at(ctx: Context, signals: SignalOptions) -> Extension:
     )
     net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / floor)
     net.add_heat_input(UNIT, target, "q_ground", factor=floor)
-    depth = signals.ground_depth_m
     return Extension(
         effect,
         net,
@@ -686,27 +691,34 @@ def _ground_at(ctx: Context, signals: SignalOptions) -> Extension:
         detail={
             "node": target,
             "floor_area_m2": floor,
-            "ground_depth_m": depth,
-            "ground_lag_months": 12.0 * depth / (2.0 * np.pi * SOIL_PENETRATION_DEPTH_M),
-            **_ground_temperatures(ctx, depth),
+            "ground_depth_m": signals.ground_depth_m,
+            "ground_lag_months": 12.0 * ground_lag(signals.ground_depth_m) / YEAR_S,
+            **soil,
         },
     )
 
 
-def _ground_temperatures(ctx: Context, depth_m: float) -> dict[str, float]:
-    """What the fitted ground temperature is judged against, over the training period [°C]: the
-    mean of T_base read ``depth_m`` deep, the outdoor annual mean (with its standard error [K])
-    and the mean indoor temperature."""
+def _ground_temperatures(ctx: Context, depths_m: list[float]) -> list[dict[str, float]]:
+    """What the fitted ground temperature is judged against, over the training period [°C], per
+    depth: the mean of T_base read that deep, the outdoor annual mean (with its standard error
+    [K]) and the mean indoor temperature (the annual cycle read once for all depths)."""
     times, t_out = ctx.data.times, ctx.train[T_OUT].to_numpy(dtype=float)
     latitude = ctx.building.location.latitude
     cycle = annual_cycle(times, t_out, latitude)
-    base = seasonal_ground_temperature(times, t_out, latitude, depth_m, cycle)
-    return {
-        "ground_base_c": float(np.mean(base)),
+    common = {
         "outdoor_mean_c": float(cycle.mean),
         "outdoor_mean_se_k": annual_mean_uncertainty(times, t_out, cycle),
         "indoor_mean_c": float(np.nanmean(ctx.data.measured)),
     }
+    return [
+        {
+            "ground_base_c": float(
+                np.mean(seasonal_ground_temperature(times, t_out, latitude, z, cycle))
+            ),
+            **common,
+        }
+        for z in depths_m
+    ]
 
 
 def sky_view_area(building: Building) -> float:

@@ -53,6 +53,11 @@ def ground_depth(lag_s: float) -> float:
     return SOIL_PENETRATION_DEPTH_M * 2.0 * np.pi * lag_s / YEAR_S
 
 
+def ground_lag(depth_m: float) -> float:
+    """The lag of the annual wave ``depth_m`` deep, the inverse of ``ground_depth``. [s]"""
+    return depth_m * YEAR_S / (2.0 * np.pi * SOIL_PENETRATION_DEPTH_M)
+
+
 GROUND_DEPTH_M = ground_depth(GROUND_LAG_S)
 # Coldest day of the outdoor annual cycle: about 25 days after the winter solstice in mid-latitude
 # climates (day of year, northern hemisphere; half a year later in the southern). [d]
