@@ -157,6 +157,10 @@ def test_older_documents_load_and_unreadable_ones_say_why(frame):
         ModelSpec.from_dict(future)
     with pytest.raises(ModelError, match="no 'network'"):
         ModelSpec.from_dict({k: v for k, v in document.items() if k != "network"})
+    deep = json.loads(json.dumps(document))
+    deep["signals"]["ground_depth_m"] = "deep"
+    with pytest.raises(ModelError, match="'ground_depth_m' must be metres"):
+        ModelSpec.from_dict(deep)
     with pytest.raises(ModelError, match="must be JSON"):
         ModelSpec.from_json("{not json")
 

@@ -77,6 +77,13 @@ class SignalOptions:
     cloud_cover: str = "estimated"
     ground_depth_m: float = GROUND_DEPTH_M
 
+    def __post_init__(self) -> None:
+        depth = self.ground_depth_m
+        if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0 <= depth < 1e3:
+            raise ValueError(
+                f"signal setting 'ground_depth_m' must be metres in [0, 1000), not {depth!r}"
+            )
+
     @classmethod
     def for_columns(cls, columns: Iterable[str], **options: Any) -> SignalOptions:
         """Options for data with ``columns``: the measured cloud cover where there is one."""
