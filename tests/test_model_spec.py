@@ -161,6 +161,11 @@ def test_older_documents_load_and_unreadable_ones_say_why(frame):
     deep["signals"]["ground_depth_m"] = "deep"
     with pytest.raises(ModelError, match="'ground_depth_m' must be metres"):
         ModelSpec.from_dict(deep)
+    for name, value in [("sky_model", "cubist"), ("input_hold", 1), ("albedo", 1.5)]:
+        odd = json.loads(json.dumps(document))
+        odd["signals"][name] = value
+        with pytest.raises(ModelError, match=f"signal setting '{name}' must be"):
+            ModelSpec.from_dict(odd)
     with pytest.raises(ModelError, match="must be JSON"):
         ModelSpec.from_json("{not json")
 

@@ -36,12 +36,25 @@ from rcengine.signals.ground import (
     AnnualCycle,
     seasonal_ground_temperature,
 )
-from rcengine.signals.schedules import Zone, clock_zone, closed_weekdays, schedule_signal
-from rcengine.signals.solar import solar_gains, solar_signal_names
+from rcengine.signals.schedules import CLOCKS, Zone, clock_zone, closed_weekdays, schedule_signal
+from rcengine.signals.sky import CLOUD_SOURCES, SKY_EMISSIVITY, sky_delta
+from rcengine.signals.solar import (
+    DECOMPOSITION_MODELS,
+    IAM_MODELS,
+    SKY_MODELS,
+    solar_gains,
+    solar_signal_names,
+)
+from rcengine.statespace import HOLDS
 
 # Indoor temperature of the air-exchange losses where none was measured before (and none after):
 # a heated building's usual setpoint. [°C]
 T_REF_C = 20.0
+
+
+def _number_in(value: object, low: float, high: float) -> bool:
+    """Whether ``value`` is a real number (not a bool) within [low, high]."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
 
 
 @dataclass(frozen=True)
@@ -78,10 +91,20 @@ class SignalOptions:
     ground_depth_m: float = GROUND_DEPTH_M
 
     def __post_init__(self) -> None:
-        depth = self.ground_depth_m
-        if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0 <= depth < 1e3:
+        # A stored model file is read back through here: a setting no signal knows is refused
+        # when the file is read, naming it, not when a forecast first derives the signal.
+        for name, allowed in _CHOICES.items():
+            value = getattr(self, name)
+            if not isinstance(value, str) or value not in allowed:
+                raise ValueError(f"signal setting {name!r} must be one of {allowed}, not {value!r}")
+        if self.albedo is not None and not _number_in(self.albedo, 0.0, 1.0):
             raise ValueError(
-                f"signal setting 'ground_depth_m' must be metres in [0, 1000), not {depth!r}"
+                f"signal setting 'albedo' must be in [0, 1] or null, not {self.albedo!r}"
+            )
+        if not _number_in(self.ground_depth_m, 0.0, 1e3) or self.ground_depth_m == 1e3:
+            raise ValueError(
+                f"signal setting 'ground_depth_m' must be metres in [0, 1000), not "
+                f"{self.ground_depth_m!r}"
             )
 
     @classmethod
@@ -102,6 +125,17 @@ class SignalOptions:
     def to_dict(self) -> dict:
         return asdict(self)
 
+
+# The named settings and the values each may take.
+_CHOICES = {
+    "sky_model": SKY_MODELS,
+    "iam_model": IAM_MODELS,
+    "decomposition": DECOMPOSITION_MODELS,
+    "schedule_clock": CLOCKS,
+    "input_hold": HOLDS,
+    "sky_emissivity": SKY_EMISSIVITY,
+    "cloud_cover": CLOUD_SOURCES,
+}
 
 Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
 
@@ -199,8 +233,6 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
 
 def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
-    from rcengine.signals.sky import sky_delta
-
     if options.cloud_cover == "column":
         _require(frame, CLOUD_COVER, SKY_DELTA)
     delta = sky_delta(frame, building.location, options.sky_emissivity, options.cloud_cover)
