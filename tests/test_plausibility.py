@@ -13,15 +13,22 @@ import pandas as pd
 import pytest
 
 from rcengine.building import Building
-from rcengine.columns import SOLAR_OPAQUE, T_GROUND, UNIT, solar_orientation_signal
+from rcengine.columns import (
+    Q_HVAC,
+    SKY_DELTA,
+    SOLAR_OPAQUE,
+    T_GROUND,
+    UNIT,
+    solar_orientation_signal,
+)
 from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
 from rcengine.diagnose.declared import with_declared_glazing
-from rcengine.diagnose.plausibility import GROUND_TEMPERATURE_MARGIN_K, assess
+from rcengine.diagnose.plausibility import GROUND_TEMPERATURE_MARGIN_K, SKY_H_R_TYPICAL, assess
 from rcengine.diagnose.response import node_responses
 from rcengine.io.epw import read_epw
 from rcengine.models import get_model
-from rcengine.models.physical import steady_share
+from rcengine.models.physical import steady_share, steady_state_gains
 from rcengine.signals import SignalOptions, prepare
 from rcengine.signals.derived import derive
 from rcengine.signals.ground import (
@@ -139,8 +146,9 @@ CASES = {
     ),
     "ground_coupling": Case(
         lambda e: _ground(e, 0.5, _between(e)),
-        lambda e: _ground(e, 3.0, _between(e)),
-        "U-value of the ground floor: 3 W/(m²K) exceeds any floor (≤ 2 W/(m²K))",
+        lambda e: _ground(e, 3.5, _between(e)),
+        "U-value of the ground floor without its inside film (floor slab to soil): 3.5 W/(m²K) "
+        "exceeds any floor (≤ 3.03 W/(m²K))",
     ),
     "sky_radiation": Case(
         lambda e: {"u_sky": 0.5},
@@ -341,12 +349,27 @@ def test_opaque_sun_cannot_come_from_walls_conducting_more_than_the_building(gai
     assert assess(ext, {**TRUTH_BASIC, **roof_only}).plausible
 
 
+def test_the_soil_reaches_the_slab_without_the_floors_inside_film(gain_context):
+    """ISO 13370's worst floor (U = 2 W/(m²K) with R_si = 0.17 m²K/W) passes 1/(0.5 − 0.17) =
+    3.03 W/(m²K) from the slab to the soil: a lumped interior mass coupled at 2.5 is a floor,
+    at 3.5 none is."""
+    ext = CANDIDATES["ground_coupling"](gain_context)
+    between = _between(ext)
+    assert assess(ext, {**TRUTH_BASIC, **_ground(ext, 2.5, between)}).plausible
+    assert not assess(ext, {**TRUTH_BASIC, **_ground(ext, 3.5, between)}).plausible
+
+
 def test_sky_loss_reads_as_the_u_value_of_the_sky_viewing_envelope(gain_context):
-    """u_sky·R_se·ε·h_r·A of (T_sky − t_out) reaches the room: the fitted network's steady
-    gain read back is the fitted u_sky, whatever share of the wall node's heat goes outdoors."""
+    """u_sky·R_se·ε·h_r·A of (T_sky − t_out) reaches the room, R_se a sheltered surface's film
+    (0.08 m²K/W): the fitted network's steady gain is that, and read back is the fitted u_sky,
+    whatever share of the wall node's heat goes outdoors."""
     ext = CANDIDATES["sky_radiation"](gain_context)
     assert 0.0 < ext.detail["node_share"] < 1.0
-    reading = assess(ext, {**TRUTH_BASIC, "u_sky": 0.5})
+    params = {**TRUTH_BASIC, "u_sky": 0.5}
+    gains = steady_state_gains(ext.network, params)
+    area = ext.detail["sky_view_area_m2"]
+    assert gains[SKY_DELTA] / gains[Q_HVAC] == pytest.approx(0.5 * 0.08 * SKY_H_R_TYPICAL * area)
+    reading = assess(ext, params)
     assert reading.plausible and reading.magnitudes["u_sky"]["value"] == pytest.approx(0.5)
 
 

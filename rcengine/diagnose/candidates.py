@@ -60,7 +60,6 @@ from rcengine.diagnose.response import (
     parameter_sensitivities,
 )
 from rcengine.models.bounds import (
-    R_SE,
     R_SE_SHELTERED,
     RHO_CP_AIR,
     U_OPAQUE,
@@ -739,7 +738,9 @@ def sky_radiation(ctx: Context) -> Extension | Skipped:
     ``SKY_H_R_TYPICAL`` (the lumped wall's conductance is the envelope's average, not the roof's:
     an uninsulated roof over insulated walls). ``sky_delta`` enters the envelope node, scaled
     by R_se over the share of that node's heat that warms the room under the current fit
-    (``steady_share``)."""
+    (``steady_share``). R_se is a sheltered surface's film (``R_SE_SHELTERED``), as for the
+    opaque sun: the data identify the share U·R_se, and the clear, calm nights that cool a roof
+    most are those of the least wind, so the U read is the least the share can mean."""
     effect = "sky_radiation"
     if SKY_DELTA in ctx.network.signals:
         return Skipped(effect, "the model already has sky radiation")
@@ -757,7 +758,7 @@ def sky_radiation(ctx: Context) -> Extension | Skipped:
         f"{SKY_H_R_TYPICAL:.2g} W/(m²K)",
     )
     detail = {"node": target, "sky_view_area_m2": view, "node_share": share}
-    factor = SKY_H_R_TYPICAL * R_SE * view / share
+    factor = SKY_H_R_TYPICAL * R_SE_SHELTERED * view / share
     return _with_gain(ctx, effect, u_sky, (SKY_DELTA, target), detail, factor)
 
 

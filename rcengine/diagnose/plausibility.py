@@ -31,8 +31,8 @@ from rcengine.models.bounds import (
     ABSORPTANCE_MAX,
     G_GLAZING_MAX,
     KAPPA_INTERNAL,
-    R_SE,
     R_SE_SHELTERED,
+    R_SI,
     U_GROUND_MAX,
     U_OPAQUE,
 )
@@ -74,9 +74,14 @@ UNMETERED_W_M2: Range = (0.0, 40.0)
 # of its true unmetered gains when found (0.37); it costs the sensitivity to unmetered gains
 # below a third of the metered ones. [-]
 UNMETERED_SHARE_OF_METERED = 1.0 / 3.0
-# Ground floor U-value: a slab under 300 mm of insulation to an uninsulated slab of a small
-# building (ISO 13370, the base models' ``U_GROUND_MAX``). [W/(m²K)]
-U_FLOOR: Range = (0.05, U_GROUND_MAX)
+# Conductance from the floor slab to the soil, per m²: a slab under 300 mm of insulation to an
+# uninsulated slab of a small building (ISO 13370, the base models' ``U_GROUND_MAX``). The
+# candidate couples the soil to the interior mass, of which the slab is part, not to the air:
+# ISO 13370's U counts the floor's inside film (R_si 0.17 m²K/W, heat flowing down), which lies
+# between the air and the slab, so the most the slab passes to the soil is 1/(1/U − R_si).
+# Bounded at U itself, two uninsulated San Francisco slabs (U 1.08 with the film) fitted 2.0–2.1
+# and were rejected. [W/(m²K)]
+U_FLOOR: Range = (0.05, 1.0 / (1.0 / U_GROUND_MAX - R_SI[1]))
 # The soil under a floor lies between the undisturbed soil and the indoor temperature (heat flows
 # from the one to the other, ISO 13370): the building warms it in winter and shades it in summer,
 # so over a period it is no colder than both the undisturbed soil at the slab's depth then (the
@@ -336,7 +341,14 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     )
     high = d["indoor_mean_c"] + GROUND_TEMPERATURE_MARGIN_K
     return [
-        Reading("u_floor", 1.0 / r, "W/(m²K)", "U-value of the ground floor", U_FLOOR, "floor"),
+        Reading(
+            "u_floor",
+            1.0 / r,
+            "W/(m²K)",
+            "U-value of the ground floor without its inside film (floor slab to soil)",
+            U_FLOOR,
+            "floor",
+        ),
         Reading(
             "t_ground",
             t_ground,
@@ -362,12 +374,13 @@ def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     Unlike the opaque sun's, it is not held against the fitted UA: the sky temperature it is
     driven by (Swinbank, with a cloud cover from the daily clear-sky index) is itself uncertain
     by tens of percent, which the fitted U absorbs (the project's sky variant, a 0.89 W/(m²K)
-    roof, fits 1.4)."""
+    roof, fits 1.4 read over the design film R_se = 0.04 m²K/W; it is read over a sheltered
+    surface's, ``R_SE_SHELTERED``, the least U the share can mean, as the opaque sun's α·U)."""
     area = ext.detail["sky_view_area_m2"]
     u_sky = params["u_sky"]
     if _readable_steady(ext, params):
         gains = steady_state_gains(ext.network, dict(params))
-        u_sky = gains[SKY_DELTA] / gains[Q_HVAC] / (SKY_H_R_TYPICAL * R_SE * area)
+        u_sky = gains[SKY_DELTA] / gains[Q_HVAC] / (SKY_H_R_TYPICAL * R_SE_SHELTERED * area)
     return [
         Reading(
             "u_sky",
