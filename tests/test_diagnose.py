@@ -210,10 +210,10 @@ MANIFEST = {c["case"]: c for c in json.loads((VARIANTS / "manifest.json").read_t
 # The window variant's glazing is in no description (its JSON lists the facade as opaque wall):
 # found first, on the east facade, but its final test RMSE is 0.80 × the baseline's, short of the
 # variants' 0.7 (−20 % on the single split, −14 % on the folds' pooled test; docs/diagnosis.md).
-# The sky variant is found first with 6 of 6 folds and −24 % on their pooled test, but the sky
-# from an estimated dew point leaves its single split at 0.71 × (Swinbank's sky: 0.69 ×, with
-# −16 % pooled over the folds).
-SHORT_OF_RATIO = {"window_solar_gains", "sky_radiation"}
+# The sky variant, found first with 6 of 6 folds, reaches 0.69 × (−25 % pooled over the folds)
+# since its share is read over a sheltered surface's film, whose wider search box the fit uses;
+# it was 0.71 × before: a margin of a hundredth either way.
+SHORT_OF_RATIO = {"window_solar_gains"}
 
 
 @pytest.mark.slow

@@ -372,10 +372,10 @@ def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     reached, read from the fitted network), at most the poorest wall's at the highest coupling.
 
     Unlike the opaque sun's, it is not held against the fitted UA: the sky temperature it is
-    driven by (Swinbank, with a cloud cover from the daily clear-sky index) is itself uncertain
-    by tens of percent, which the fitted U absorbs (the project's sky variant, a 0.89 W/(m²K)
-    roof, fits 1.4 read over the design film R_se = 0.04 m²K/W; it is read over a sheltered
-    surface's, ``R_SE_SHELTERED``, the least U the share can mean, as the opaque sun's α·U)."""
+    driven by (an estimated dew point and cloud cover) is itself uncertain by tens of percent,
+    which the fitted U absorbs. The share is read over a sheltered surface's film
+    (``R_SE_SHELTERED``), the least U it can mean, as the opaque sun's α·U: the project's sky
+    variant, a 0.89 W/(m²K) roof, reads 0.89 (1.69 over the design film, R_se 0.04 m²K/W)."""
     area = ext.detail["sky_view_area_m2"]
     u_sky = params["u_sky"]
     if _readable_steady(ext, params):
