@@ -20,7 +20,8 @@
     python scripts/make_testbed.py --set testbed_sealed_13  # the thirteenth (drawn, diagnosed once)
     python scripts/make_testbed.py --set testbed_sealed_14  # the fourteenth (drawn, diagnosed once)
     python scripts/make_testbed.py --set testbed_sealed_15  # the fifteenth (drawn, diagnosed once)
-    python scripts/make_testbed.py --set testbed_sealed_16  # the sixteenth (drawn, not diagnosed)
+    python scripts/make_testbed.py --set testbed_sealed_16  # the sixteenth (drawn, diagnosed once)
+    python scripts/make_testbed.py --set testbed_sealed_17  # the seventeenth (drawn, not diagnosed)
 
 Writes ``<case>/data.csv`` and ``<case>/building.json`` per case, ``manifest.json`` (archetype,
 climate, rotation, concealed effects with their physical magnitudes and measured strengths) and
