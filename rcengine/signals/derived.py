@@ -52,9 +52,9 @@ from rcengine.statespace import HOLDS
 T_REF_C = 20.0
 
 
-def _number_in(value: object, low: float, high: float) -> bool:
-    """Whether ``value`` is a real number (not a bool) within [low, high]."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
+def _is_real(value: object) -> bool:
+    """Whether ``value`` is a real number (a bool is not)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 @dataclass(frozen=True)
@@ -97,14 +97,14 @@ class SignalOptions:
             value = getattr(self, name)
             if not isinstance(value, str) or value not in allowed:
                 raise ValueError(f"signal setting {name!r} must be one of {allowed}, not {value!r}")
-        if self.albedo is not None and not _number_in(self.albedo, 0.0, 1.0):
+        if self.albedo is not None and not (_is_real(self.albedo) and 0.0 <= self.albedo <= 1.0):
             raise ValueError(
                 f"signal setting 'albedo' must be in [0, 1] or null, not {self.albedo!r}"
             )
-        if not _number_in(self.ground_depth_m, 0.0, 1e3) or self.ground_depth_m == 1e3:
+        depth = self.ground_depth_m
+        if not (_is_real(depth) and 0.0 <= depth < 1e3):
             raise ValueError(
-                f"signal setting 'ground_depth_m' must be metres in [0, 1000), not "
-                f"{self.ground_depth_m!r}"
+                f"signal setting 'ground_depth_m' must be metres in [0, 1000), not {depth!r}"
             )
 
     @classmethod
