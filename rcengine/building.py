@@ -25,12 +25,24 @@ class Surface:
     area: float
 
 
+# Said wherever a description without a time zone is read: its local hours fall back to UTC.
+NO_TIMEZONE = (
+    "location.timezone is not given, so the building's local hours (its days, the split at "
+    "local midnight, learnt schedules, the forecast's midnight) are read in UTC; give its IANA "
+    'zone, e.g. "timezone": "Europe/Rome" (or "UTC" to keep UTC)'
+)
+
+
 @dataclass(frozen=True)
 class Location:
+    """latitude, longitude: [°]; altitude: [m]; timezone: IANA name, "UTC" where the description
+    gives none (``timezone_given`` False)."""
+
     latitude: float
     longitude: float
     altitude: float = 0.0
     timezone: str = "UTC"
+    timezone_given: bool = field(default=True, compare=False)
 
 
 @dataclass(frozen=True)
@@ -65,6 +77,7 @@ class Building:
             longitude=_number(loc, "longitude", "location.longitude", -180.0, 180.0),
             altitude=_number(loc, "altitude", "location.altitude", -500.0, 9000.0, default=0.0),
             timezone=_timezone(loc.get("timezone", "UTC")),
+            timezone_given="timezone" in loc,
         )
         return cls(
             name=str(data.get("name", "building")),
@@ -83,8 +96,14 @@ class Building:
     def from_json(cls, path: str | Path) -> Building:
         return cls.from_dict(read_json(path, BuildingError))
 
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the description leaves to a default that changes results, to warn of."""
+        return () if self.location.timezone_given else (NO_TIMEZONE,)
+
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
+        del out["location"]["timezone_given"]
         out["windows"] = [asdict(s) for s in self.windows]
         out["walls"] = [asdict(s) for s in self.walls]
         return out

@@ -72,6 +72,19 @@ def fail(message: str) -> NoReturn:
     raise typer.Exit(code=2)
 
 
+def warn(message: str) -> None:
+    typer.secho(f"warning: {message}", fg=typer.colors.YELLOW, err=True)
+
+
+def _building(path: Path) -> Building:
+    """The building description, each default it leaves that changes results said as a
+    warning (``Building.notes``)."""
+    building = Building.from_json(path)
+    for note in building.notes:
+        warn(note)
+    return building
+
+
 def _check(check: Callable[[str], object], value: str) -> None:
     """Refuse an invalid option value before any work, with the engine's own message."""
     try:
@@ -180,7 +193,7 @@ def fit(
     _output(output, "-o", data, building, model_file)
 
     def run() -> None:
-        b = Building.from_json(building)
+        b = _building(building)
         first, last = _period(start, end, b.location.timezone)
         frame = bridge_short_gaps(read_timeseries(data))
         name, net, options = _model_to_fit(model, model_file, b, frame, sky_model)
@@ -200,7 +213,7 @@ def fit(
         params.save(output)
         _print_fit(params, est)
         for w in caught:
-            typer.secho(f"warning: {w.message}", fg=typer.colors.YELLOW, err=True)
+            warn(str(w.message))
         typer.echo(f"wrote {output}")
 
     _run(run)
@@ -347,7 +360,7 @@ def diagnose(
         fail("--json, --html and --save-model must name different files")
 
     def run() -> None:
-        b = Building.from_json(building)
+        b = _building(building)
         frame = read_timeseries(data)
         settings = DiagnoseSettings(train_fraction=train_fraction, random_state=seed)
         report = selection.diagnose(frame, b, model, settings, progress=typer.echo)
@@ -433,7 +446,7 @@ def study(
 
     def run() -> None:
         started = time.perf_counter()
-        b = Building.from_json(building)
+        b = _building(building)
         first, last = _period(start, end, b.location.timezone)
         frame = read_timeseries(data)
         # Read before the study, not after it: a bad file found then cost the whole run.

@@ -246,6 +246,23 @@ def test_fit_reads_local_dates_in_the_buildings_zone(office, office_fit, tmp_pat
         assert fit[key] == by_offset[key], key
 
 
+@pytest.mark.parametrize("zoned", [True, False])
+def test_a_building_without_a_time_zone_is_read_in_utc_with_a_warning(workdir, zoned):
+    description = json.loads(Path("b.json").read_text())
+    if not zoned:
+        del description["location"]["timezone"]
+    Path("b.json").write_text(json.dumps(description))
+    result = invoke(
+        "fit", "data.csv", "--building", "b.json", "--model", "basic",
+        "--start", OFFICE_FIT[0], "--end", OFFICE_FIT[1], "-o", "p.json",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    warned = "warning: location.timezone is not given" in result.stderr
+    assert warned != zoned, result.stderr
+    zone = json.loads(Path("p.json").read_text())["building"]["location"]["timezone"]
+    assert zone == (description["location"]["timezone"] if zoned else "UTC")
+
+
 def test_predict_reads_a_local_date_in_the_parameter_files_zone(office, office_fit, tmp_path):
     out = tmp_path / "forecast.csv"
     result = invoke(

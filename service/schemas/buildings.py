@@ -86,6 +86,7 @@ class BuildingCreated(BaseModel):
             "name": "office-torino",
             "token": "0b3Xq1u8Yf3n8m0c2r3vJ8b9J1ZKq7w3fX4o5p6q7r8",
             "created_at": "2017-01-09T06:15:00+01:00",
+            "warnings": [],
         }
     )
 
@@ -93,6 +94,11 @@ class BuildingCreated(BaseModel):
     name: str
     token: str = Field(description="Bearer token for this building's calls; shown only once")
     created_at: LocalTime
+    warnings: list[str] = Field(
+        default_factory=list,
+        description="Defaults the description leaves that change results (a missing time zone "
+        "reads the building's local hours in UTC)",
+    )
 
 
 class TokenRotated(BaseModel):

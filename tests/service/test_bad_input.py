@@ -315,3 +315,15 @@ def test_invalid_building_description_names_the_field(client, change, field):
     # The field is the problem's column, as for a request that fails the schema.
     assert any(field in (p["column"] or "") for p in response.json()["problems"]), response.text
     assert client.get("/buildings", headers=ADMIN).json()["items"] == []
+
+
+def test_a_description_without_a_time_zone_is_registered_with_a_warning(client):
+    location = {k: v for k, v in SYNTHETIC_BUILDING["location"].items() if k != "timezone"}
+    response = client.post(
+        "/buildings", json={**SYNTHETIC_BUILDING, "location": location}, headers=ADMIN
+    )
+    assert response.status_code == 201, response.text
+    (warning,) = response.json()["warnings"]
+    assert "location.timezone is not given" in warning and "in UTC" in warning
+    named = client.post("/buildings", json={**SYNTHETIC_BUILDING, "name": "zoned"}, headers=ADMIN)
+    assert named.json()["warnings"] == []

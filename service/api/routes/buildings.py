@@ -43,7 +43,13 @@ def create_building(body: BuildingCreate, ctx: ContextDep) -> BuildingCreated:
             hash_token(token),
         )
     return BuildingCreated.model_validate(
-        {"id": record.id, "name": record.name, "token": token, "created_at": record.created_at},
+        {
+            "id": record.id,
+            "name": record.name,
+            "token": token,
+            "created_at": record.created_at,
+            "warnings": list(building.notes),
+        },
         context=in_zone(record.timezone),
     )
 
