@@ -10,6 +10,7 @@ from rcengine.columns import T_GROUND, VENT_LOSS, VENT_SCHEDULE, WIND_LOSS, sche
 from rcengine.exceptions import ModelError
 from rcengine.io.timeseries import read_timeseries
 from rcengine.signals.derived import SignalOptions, derive, derivers, mask_measured
+from rcengine.signals.film import facade_wind, film_factor, film_resistance
 from rcengine.signals.ground import YEAR_S, ground_depth, ground_temperature
 from rcengine.signals.schedules import (
     clock_zone,
@@ -27,6 +28,7 @@ from rcengine.signals.sky import (
     sky_delta,
     sky_temperature,
 )
+from rcengine.signals.solar import solar_signal_names
 
 
 def test_hour_of_week_is_local_time():
@@ -161,6 +163,53 @@ def test_stored_options_without_a_sky_model_keep_swinbank():
     assert SignalOptions.from_stored({"sky_model": "perez"}).sky_emissivity == "swinbank"
     stored = SignalOptions(sky_emissivity="clark_allen").to_dict()
     assert SignalOptions.from_stored(stored) == SignalOptions()
+
+
+def test_the_outer_film_follows_iso_6946_annex_c():
+    """h_se = 4 + 4·v + ε·h_r0 (ε 0.9, 0 °C): 0.082 m²K/W at 1 m/s (a sheltered facade), the
+    design 0.04 at 4 m/s. The facade's wind is the station's carried to 5 m of a suburban site
+    (ASHRAE's power law: (270/10)^0.14 · (5/370)^0.22 = 0.615); the factor is 1 where the facade
+    has 1 m/s, and a gale cuts a calm day's share by more than half."""
+    h_re = 0.9 * 4 * 5.67e-8 * 273.15**3
+    np.testing.assert_allclose(
+        film_resistance([0.0, 1.0, 4.0]), 1 / (4.0 + h_re + 4.0 * np.array([0.0, 1.0, 4.0]))
+    )
+    assert film_resistance(1.0) == pytest.approx(0.082, abs=5e-4)
+    assert film_resistance(4.0) == pytest.approx(0.04, abs=2e-3)
+    ratio = (270 / 10) ** 0.14 * (5 / 370) ** 0.22
+    assert ratio == pytest.approx(0.615, abs=1e-3)
+    np.testing.assert_allclose(facade_wind([0.0, 10.0]), [0.0, 10.0 * ratio])
+    assert film_factor(1.0 / ratio) == pytest.approx(1.0)
+    assert film_factor(0.0) / film_factor(15.0) > 2.0
+    assert film_factor(-1.0) == film_factor(0.0)  # no negative wind
+
+
+def test_the_wind_strips_the_sun_of_the_opaque_facades_only(project_data):
+    """With the film "wind", each orientation's opaque sun is scaled by the film factor of the
+    row's wind; the window's sun, the thesis's summed opaque sun and the sky are not. Stored
+    options without the setting keep the fixed film, and a model so fitted says it needs the
+    wind."""
+    office = project_data / "energyplus" / "office"
+    building = Building.from_json(office / "building.json")
+    frame = read_timeseries(office / "heating.csv").iloc[: 2 * 96]
+    frame = frame.assign(wind_speed=np.linspace(0.0, 9.0, len(frame)))
+    names = [n for n in solar_signal_names(building) if n.startswith("solar_")]
+    names += ["sky_delta"]
+    fixed = derive(frame, building, names, SignalOptions())
+    windy = SignalOptions(exterior_film="wind")
+    filmed = derive(frame, building, names, windy)
+    factor = film_factor(frame["wind_speed"].to_numpy())
+    for name in names:
+        scaled = name.startswith("solar_opaque_")
+        expected = fixed[name] * factor if scaled else fixed[name]
+        np.testing.assert_allclose(filmed[name], expected, err_msg=name)
+    assert any(n.startswith("solar_opaque_") for n in names)
+    assert SignalOptions.from_stored({"sky_model": "isotropic"}).exterior_film == "fixed"
+    assert SignalOptions.from_stored(windy.to_dict()) == windy
+    with pytest.raises(ModelError, match="needs the column 'wind_speed'"):
+        derive(frame.drop(columns="wind_speed"), building, names, windy)
+    with pytest.raises(ValueError, match="exterior_film"):
+        SignalOptions(exterior_film="calm")
 
 
 def test_t_ground_reads_the_soil_at_the_stored_depth(project_data):

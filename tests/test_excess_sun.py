@@ -15,7 +15,7 @@ import pytest
 from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.candidates import CANDIDATES, Context
 from rcengine.diagnose.declared import with_declared_glazing
-from rcengine.diagnose.excess_sun import JUDGED_AFTER, capped_bounds, declared_g
+from rcengine.diagnose.excess_sun import JUDGED_AFTER, capped_bounds, declared_g, held_to_glass
 from rcengine.models import get_model
 from rcengine.models.bounds import G_GLAZING_MAX
 from rcengine.signals import SignalOptions, prepare
@@ -64,6 +64,10 @@ def test_the_glazing_is_held_to_glass_in_its_own_split_between_mass_and_air():
     assert bounds["g_window_air"][1] == pytest.approx(0.3 * G_GLAZING_MAX / 1.2)
     others = {n: (p.lower, p.upper) for n, p in net.parameters.items() if not n.startswith("g_")}
     assert {n: b for n, b in bounds.items() if not n.startswith("g_")} == others
+    # The model that goes on keeps the cap as its own bounds; the network given is untouched.
+    held = held_to_glass(net, params, g)
+    assert {n: (p.lower, p.upper) for n, p in held.parameters.items()} == bounds
+    assert net.parameters["g_window"].upper == G_GLAZING_MAX
     assert declared_g(get_model("basic", SMALL, frame.columns), TRUTH_BASIC) is None
 
 

@@ -178,6 +178,13 @@ def test_the_columns_a_model_needs_are_named(frame):
     measured_sky = SignalOptions(cloud_cover="column")
     assert columns_needed(["sky_delta"], measured_sky) == ["cloud_cover", "t_out", "ghi"]
     assert columns_needed(["wind_loss"], measured_sky) == ["t_out", "wind_speed"]
+    # An outer film that follows the wind needs it under each orientation's opaque sun only.
+    windy = SignalOptions(exterior_film="wind")
+    assert columns_needed(["solar_opaque_90_90"], windy) == ["wind_speed", "ghi"]
+    assert columns_needed(["solar_window_90_90", "solar_opaque", "sky_delta"], windy) == [
+        "ghi",
+        "t_out",
+    ]
     start, end = frame.index[10], frame.index[20]
     check_future_columns(frame, ["sky_delta"], start, end)
     with pytest.raises(DataValidationError, match="needs 'cloud_cover' over the forecast"):

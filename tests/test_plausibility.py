@@ -19,6 +19,7 @@ from rcengine.columns import (
     SOLAR_OPAQUE,
     T_GROUND,
     UNIT,
+    WIND_SPEED,
     solar_orientation_signal,
 )
 from rcengine.diagnose import candidates
@@ -233,6 +234,18 @@ def test_an_emitter_may_charge_the_slab_it_lies_on(gain_context, loss_context):
         "emitter heat capacity per m² of floor: 800 kJ/(m²K) exceeds any emitter (a thermally "
         "activated slab included) (≤ 720 kJ/(m²K))"
     ]
+
+
+def test_the_opaque_sun_passes_a_film_that_follows_the_wind(gain_context):
+    """Where the data have a wind speed the opaque sun reaches the wall through a film that
+    follows it (``signals.film``); without one, through a sheltered facade's fixed film. The
+    other candidates keep the signals they were given."""
+    still = replace(gain_context.data, frame=gain_context.train.drop(columns=WIND_SPEED))
+    calm = replace(gain_context, data=still)
+    assert CANDIDATES["opaque_solar_gains"](gain_context).signals.exterior_film == "wind"
+    assert CANDIDATES["opaque_solar_gains"](calm).signals.exterior_film == "fixed"
+    for effect in ("sky_radiation", "wind_infiltration"):
+        assert CANDIDATES[effect](gain_context).signals == gain_context.signals, effect
 
 
 def test_implausibly_small_magnitudes_are_rejected_too(gain_context):

@@ -175,6 +175,19 @@ def mass_node(net: RCNetwork) -> str:
     return inside[0] if inside else net.output
 
 
+def _has_wind(ctx: Context) -> bool:
+    return WIND_SPEED in ctx.train.columns and bool(ctx.train[WIND_SPEED].notna().any())
+
+
+def _through_the_film(ctx: Context) -> Context:
+    """``ctx`` with the envelope's outer film varying with the wind where the data have a wind
+    speed (``signals.film``): the film sets the share of an outer surface's sun that reaches
+    the room, and a fixed film leaves the wind's part of it to a wind-driven leak."""
+    if not _has_wind(ctx):
+        return ctx
+    return replace(ctx, signals=replace(ctx.signals, exterior_film="wind"))
+
+
 def _has_signal(net: RCNetwork, prefix: str) -> bool:
     return any(s.startswith(prefix) for s in net.signals)
 
@@ -299,9 +312,11 @@ def opaque_solar_gains(ctx: Context) -> Extension | Skipped:
     its steady share is α·U·R_se. The data identify that share, not α·U: R_se is a sheltered
     facade's film (``R_SE_SHELTERED``, the most an outside film passes in), so the α·U fitted is
     the least the share can mean, and the plausibility checks reject only what no envelope could
-    pass.
+    pass. Where the data have a wind speed the film follows it (``signals.film``, relative to
+    that sheltered film): a windy day's film passes half a calm one's sun.
     """
     effect = "opaque_solar_gains"
+    ctx = _through_the_film(ctx)
     if not ctx.building.walls:
         return Skipped(effect, "no opaque walls ('walls') in the building JSON")
     if _has_signal(ctx.network, SOLAR_OPAQUE):
@@ -387,7 +402,7 @@ def wind_infiltration(ctx: Context) -> Extension | Skipped:
     loss = n_wind · ρc_pV/3600 · wind · (t_in − t_out), t_in the measured indoor temperature
     (``signals.derived.indoor_operating_point``)."""
     effect = "wind_infiltration"
-    if WIND_SPEED not in ctx.train.columns or not ctx.train[WIND_SPEED].notna().any():
+    if not _has_wind(ctx):
         return Skipped(effect, "no wind_speed column in the data")
     return _air_change_loss(
         ctx,

@@ -13,15 +13,18 @@ opaque envelope.
 
 Where the building declares glazing, the opaque sun is therefore judged here, once the selection
 has ended, and not in its rounds: a model whose declared glazing still admits more sun than glass
-is refitted twice with the glazing held to glass (``capped_bounds``), as it is and with the
+is refitted twice with the glazing held to glass (``held_to_glass``), as it is and with the
 opaque sun. The opaque sun is accepted when, with physical windows, it forecasts the test period
 at least as well as the model with impossible windows did, better than that model's own
 apertures can with the windows held to glass, with a non-zero gain and every fitted magnitude
-plausible for the building.
+plausible for the building. The glazing stays held to glass in the model that goes on (its
+network's bounds), so the backward check that follows compares every finding with physical
+windows.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from rcengine.columns import SOLAR_WINDOW
@@ -74,17 +77,28 @@ def capped_bounds(
     return bounds
 
 
-def attribute_excess_sun(problem: Problem, state: Selection, ctx: Context) -> None:
+def held_to_glass(network: RCNetwork, params: dict[str, float], g: float) -> RCNetwork:
+    """A copy of ``network`` whose declared glazing's bounds are ``capped_bounds``."""
+    bounds = capped_bounds(network, params, g)
+    held = network.copy(network.name)
+    for name in DECLARED_G:
+        if name in held.parameters:
+            lower, upper = bounds[name]
+            held.parameters[name] = replace(held.parameters[name], lower=lower, upper=upper)
+    return held
+
+
+def attribute_excess_sun(problem: Problem, state: Selection, ctx: Context) -> bool:
     """After the selection: where the model's declared glazing admits more sun than glass,
     refit it held to glass with and without the opaque sun, and accept the opaque sun when it
-    carries the excess (``ctx``: the current model's candidate context)."""
+    carries the excess (``ctx``: the current model's candidate context); whether it did."""
     current = state.current
     g = declared_g(current.network, current.params)
     if g is None or g <= G_GLAZING_MAX or EFFECT not in problem.settings.effects:
-        return
+        return False
     ext = CANDIDATES[EFFECT](ctx)
     if isinstance(ext, Skipped):
-        return
+        return False
     problem.say(
         f"the declared glazing admits g = {g:.2f}, more than glass ({G_GLAZING_MAX:g}): "
         f"trying {EFFECT} with the glazing held to glass"
@@ -96,17 +110,19 @@ def attribute_excess_sun(problem: Problem, state: Selection, ctx: Context) -> No
         state.take(finding)
     else:
         state.verdicts[EFFECT] = finding
+    return finding.accepted
 
 
 def _capped_fits(problem: Problem, current: Fit, ext: Extension, g: float) -> list[Fit]:
-    """The current model and ``ext`` refitted with the declared glazing held to glass,
-    warm-started from the current fit with the glazing scaled down to glass."""
+    """The current model and ``ext`` refitted with the declared glazing held to glass
+    (``held_to_glass``), warm-started from the current fit with the glazing scaled down to
+    glass."""
     settings = problem.settings
     models = [(current.network, current.options, {}), (ext.network, ext.signals, ext.neutral)]
     jobs = []
     for network, options, neutral in models:
-        bounds = capped_bounds(network, current.params, g)
-        held = {n: bounds[n][1] for n in DECLARED_G if n in bounds}  # the glazing at its cap
+        network = held_to_glass(network, current.params, g)
+        at_cap = {n: network.parameters[n].upper for n in DECLARED_G if n in network.parameters}
         jobs.append(
             FitJob(
                 network,
@@ -114,8 +130,7 @@ def _capped_fits(problem: Problem, current: Fit, ext: Extension, g: float) -> li
                 problem.split(network, options),
                 settings.preset,
                 settings.random_state,
-                [{**current.params, **held, **neutral}],
-                bounds,
+                [{**current.params, **at_cap, **neutral}],
             )
         )
     return fit_many(jobs, settings.workers)

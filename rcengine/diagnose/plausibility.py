@@ -37,6 +37,7 @@ from rcengine.models.bounds import (
     U_OPAQUE,
 )
 from rcengine.models.physical import solar_apertures, steady_state_gains, ua
+from rcengine.signals.film import H_RE, STEFAN_BOLTZMANN
 from rcengine.signals.ground import ESTIMATE_Z
 
 if TYPE_CHECKING:
@@ -92,14 +93,13 @@ U_FLOOR: Range = (0.05, 1.0 / (1.0 / U_GROUND_MAX - R_SI[1]))
 GROUND_TEMPERATURE_MARGIN_K = 2.0
 # Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
 # −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
-STEFAN_BOLTZMANN = 5.670e-8
 SKY_COUPLING: Range = (
     0.1 * 4 * STEFAN_BOLTZMANN * 253.15**3,
     0.95 * 4 * STEFAN_BOLTZMANN * 303.15**3,
 )
 # ε·h_r of a painted, brick or roofing surface (ε = 0.9) at 0 °C, the coupling at which the sky
-# candidate reads its fitted loss as a U-value. [W/(m²K)]
-SKY_H_R_TYPICAL = 0.9 * 4 * STEFAN_BOLTZMANN * 273.15**3
+# candidate reads its fitted loss as a U-value: the outer film's radiative part. [W/(m²K)]
+SKY_H_R_TYPICAL = H_RE
 # Storage the model lacks, per m² of floor: the base models' internal-mass range (10–1000 kJ).
 EXTRA_CAPACITY_J_M2K: Range = KAPPA_INTERNAL
 # The heaviest emitter: a thermally activated building system (ISO 11855-4, EN 15377-3), pipes

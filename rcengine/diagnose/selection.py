@@ -173,8 +173,10 @@ def _diagnose(
         _repair(problem, state)
     _select(problem, state)
     _backward(problem, state)
-    if problem.settings.excess_sun:
-        attribute_excess_sun(problem, state, _context(problem, state.current))
+    if problem.settings.excess_sun and attribute_excess_sun(
+        problem, state, _context(problem, state.current)
+    ):
+        _backward(problem, state)
     findings = state.findings(locate["train"]["summary"])
     whiteness = {
         "baseline": ljung_box(baseline.innovations_test, baseline.split.test.times),
@@ -625,7 +627,10 @@ def _backward(problem: Problem, state: Selection) -> None:
     entered by) and is worth least is dropped and the check repeated on the model without it;
     the findings kept are ordered by what leaving each out costs on the folds' pooled test, the
     one that matters most first. Steps taken to make the base model healthy are not candidates
-    and stay first.
+    and stay first. A finding accepted on other evidence than the folds (the opaque sun, from
+    what the declared glazing admits beyond glass, ``excess_sun``) is ordered with the others
+    but not dropped by them; it is checked after it too, since a finding taken before it may
+    have stood in for its sun.
     """
     rule, timezone = problem.settings.fold_rule, problem.building.location.timezone
     while problem.folds:
@@ -641,7 +646,7 @@ def _backward(problem: Problem, state: Selection) -> None:
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
             finding.backward = {**ev.to_dict(problem.folds, timezone), "still_needed": ok}
             finding.backward["reason"] = f"added last, to the other findings: {text}"
-            if not ok:
+            if not ok and finding.evidence is not None:
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
         if not failing:

@@ -36,6 +36,7 @@ from rcengine.columns import (
     SOLAR_WINDOW,
     T_GROUND,
     T_OUT,
+    WIND_SPEED,
 )
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.files import write_text_atomic
@@ -61,11 +62,15 @@ def building_key(building: Building) -> str:
 
 def columns_needed(inputs: Iterable[str], signals: SignalOptions | None = None) -> list[str]:
     """The contract columns the model inputs ``inputs`` are read or derived from (with the
-    derived-signal settings ``signals``: a sky read from measured cloud cover needs it)."""
+    derived-signal settings ``signals``: a sky read from measured cloud cover needs it, an opaque
+    sun through an outer film that follows the wind the wind speed)."""
     needed: list[str] = []
     for name in inputs:
         if name == SKY_DELTA and signals is not None and signals.cloud_cover == "column":
             needed.append(CLOUD_COVER)
+        filmed = name.startswith(f"{SOLAR_OPAQUE}_")
+        if filmed and signals is not None and signals.exterior_film == "wind":
+            needed.append(WIND_SPEED)
         if name in NUMERIC_COLUMNS:
             needed.append(name)
         elif name in DERIVED_FROM:

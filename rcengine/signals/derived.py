@@ -19,6 +19,7 @@ from rcengine.columns import (
     CLOUD_COVER,
     NUMERIC_COLUMNS,
     SKY_DELTA,
+    SOLAR_OPAQUE,
     T_GROUND,
     T_IN,
     T_OUT,
@@ -31,6 +32,7 @@ from rcengine.columns import (
 )
 from rcengine.dataset import Dataset
 from rcengine.exceptions import ModelError
+from rcengine.signals.film import EXTERIOR_FILMS, film_factor
 from rcengine.signals.ground import (
     GROUND_DEPTH_M,
     AnnualCycle,
@@ -75,7 +77,11 @@ class SignalOptions:
     (from ``ghi``) or "column" (the data's ``cloud_cover``, which a forecast's future rows then
     need too; ``for_columns`` chooses it when the fitted data have the column); ground_depth_m:
     how deep into the soil ``t_ground`` reads the annual cycle (``signals.ground``; a month's
-    lag, which parameter sets stored before it existed were fitted with). [m]
+    lag, which parameter sets stored before it existed were fitted with) [m]; exterior_film:
+    the outer surface film under each orientation's opaque sun (``solar_opaque_<k>``), "fixed"
+    (a sheltered facade's, which parameter sets stored before it existed were fitted with) or
+    "wind" (``signals.film``: varying with the data's ``wind_speed``, which a forecast's future
+    rows then need too).
     """
 
     sky_model: str = "isotropic"
@@ -89,6 +95,7 @@ class SignalOptions:
     sky_emissivity: str = "clark_allen"
     cloud_cover: str = "estimated"
     ground_depth_m: float = GROUND_DEPTH_M
+    exterior_film: str = "fixed"
 
     def __post_init__(self) -> None:
         # A stored model file is read back through here: a setting no signal knows is refused
@@ -135,13 +142,16 @@ _CHOICES = {
     "input_hold": HOLDS,
     "sky_emissivity": SKY_EMISSIVITY,
     "cloud_cover": CLOUD_SOURCES,
+    "exterior_film": EXTERIOR_FILMS,
 }
 
 Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
 
 
 def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    return solar_gains(
+    """The solar signals (``signals.solar``), each orientation's opaque sun through the outer
+    film of ``options.exterior_film``; the thesis's sum ``solar_opaque`` as it defines it."""
+    out = solar_gains(
         frame,
         building,
         sky_model=options.sky_model,
@@ -149,6 +159,16 @@ def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> p
         iam_model=options.iam_model,
         decomposition=options.decomposition,
     )
+    per_orientation = [c for c in out.columns if c.startswith(f"{SOLAR_OPAQUE}_")]
+    if per_orientation and options.exterior_film == "wind":
+        film = _film(frame, per_orientation[0])
+        out[per_orientation] = out[per_orientation].mul(film, axis=0)
+    return out
+
+
+def _film(frame: pd.DataFrame, signal: str) -> np.ndarray:
+    """The outer film's share at each row's wind over a sheltered facade's (``film_factor``)."""
+    return film_factor(_require(frame, WIND_SPEED, signal))
 
 
 def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
