@@ -206,8 +206,12 @@ def test_the_wind_strips_the_sun_of_the_opaque_facades_only(project_data):
     assert any(n.startswith("solar_opaque_") for n in names)
     assert SignalOptions.from_stored({"sky_model": "isotropic"}).exterior_film == "fixed"
     assert SignalOptions.from_stored(windy.to_dict()) == windy
+    calm = frame.drop(columns="wind_speed")
     with pytest.raises(ModelError, match="needs the column 'wind_speed'"):
-        derive(frame.drop(columns="wind_speed"), building, names, windy)
+        derive(calm, building, names, windy)
+    # A model with the setting but no opaque sun (it was dropped) needs no wind.
+    others = [n for n in names if not n.startswith("solar_opaque_")]
+    pd.testing.assert_frame_equal(derive(calm, building, others, windy), fixed[others])
     with pytest.raises(ValueError, match="exterior_film"):
         SignalOptions(exterior_film="calm")
 

@@ -149,9 +149,28 @@ Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
 
 
 def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """The solar signals (``signals.solar``), each orientation's opaque sun through the outer
-    film of ``options.exterior_film``; the thesis's sum ``solar_opaque`` as it defines it."""
-    out = solar_gains(
+    """The solar signals (``signals.solar``); each orientation's opaque sun is ``_opaque_sun``'s."""
+    return _solar_gains(frame, building, options)
+
+
+def _opaque_sun(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    """Each orientation's opaque sun ``solar_opaque_<k>`` [W] through the outer film of
+    ``options.exterior_film``: one that follows the wind needs the data's ``wind_speed``, and only
+    a model taking these signals does (the thesis's summed ``solar_opaque`` is ``_solar``'s)."""
+    out = _solar_gains(frame, building, options)
+    out = out[[c for c in out.columns if _is_opaque_orientation(c)]]
+    if options.exterior_film == "wind" and len(out.columns):
+        film = film_factor(_require(frame, WIND_SPEED, out.columns[0]))
+        out = out.mul(film, axis=0)
+    return out
+
+
+def _is_opaque_orientation(name: str) -> bool:
+    return name.startswith(f"{SOLAR_OPAQUE}_")
+
+
+def _solar_gains(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+    return solar_gains(
         frame,
         building,
         sky_model=options.sky_model,
@@ -159,16 +178,6 @@ def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> p
         iam_model=options.iam_model,
         decomposition=options.decomposition,
     )
-    per_orientation = [c for c in out.columns if c.startswith(f"{SOLAR_OPAQUE}_")]
-    if per_orientation and options.exterior_film == "wind":
-        film = _film(frame, per_orientation[0])
-        out[per_orientation] = out[per_orientation].mul(film, axis=0)
-    return out
-
-
-def _film(frame: pd.DataFrame, signal: str) -> np.ndarray:
-    """The outer film's share at each row's wind over a sheltered facade's (``film_factor``)."""
-    return film_factor(_require(frame, WIND_SPEED, signal))
 
 
 def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
@@ -264,6 +273,7 @@ def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
     (one function may compute several signals: it then runs once for all of them)."""
     return {
         **dict.fromkeys(solar_signal_names(building), _solar),
+        **dict.fromkeys(filter(_is_opaque_orientation, solar_signal_names(building)), _opaque_sun),
         WIND_LOSS: _wind_loss,
         VENT_LOSS: _vent_loss,
         **{schedule_signal_name(name): _schedules for name in options.schedules},
