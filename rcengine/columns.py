@@ -111,3 +111,8 @@ def solar_orientation_signal(total: str, orientation: str) -> str:
     """The share of ``total`` (``SOLAR_WINDOW`` or ``SOLAR_OPAQUE``) falling on the surfaces of
     one orientation (``orientation_key``), e.g. ``solar_window_180_90``. [W]"""
     return f"{total}_{orientation}"
+
+
+def is_orientation_signal(name: str, total: str) -> bool:
+    """Whether ``name`` is one orientation's share of ``total`` (``solar_orientation_signal``)."""
+    return name.startswith(f"{total}_")

@@ -37,6 +37,7 @@ from rcengine.columns import (
     T_GROUND,
     T_OUT,
     WIND_SPEED,
+    is_orientation_signal,
 )
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.files import write_text_atomic
@@ -68,7 +69,7 @@ def columns_needed(inputs: Iterable[str], signals: SignalOptions | None = None) 
     for name in inputs:
         if name == SKY_DELTA and signals is not None and signals.cloud_cover == "column":
             needed.append(CLOUD_COVER)
-        filmed = name.startswith(f"{SOLAR_OPAQUE}_")
+        filmed = is_orientation_signal(name, SOLAR_OPAQUE)
         if filmed and signals is not None and signals.exterior_film == "wind":
             needed.append(WIND_SPEED)
         if name in NUMERIC_COLUMNS:

@@ -28,6 +28,7 @@ from rcengine.columns import (
     VENT_SCHEDULE,
     WIND_LOSS,
     WIND_SPEED,
+    is_orientation_signal,
     schedule_signal_name,
 )
 from rcengine.dataset import Dataset
@@ -158,15 +159,11 @@ def _opaque_sun(frame: pd.DataFrame, building: Building, options: SignalOptions)
     ``options.exterior_film``: one that follows the wind needs the data's ``wind_speed``, and only
     a model taking these signals does (the thesis's summed ``solar_opaque`` is ``_solar``'s)."""
     out = _solar_gains(frame, building, options)
-    out = out[[c for c in out.columns if _is_opaque_orientation(c)]]
+    out = out[[c for c in out.columns if is_orientation_signal(c, SOLAR_OPAQUE)]]
     if options.exterior_film == "wind" and len(out.columns):
         film = film_factor(_require(frame, WIND_SPEED, out.columns[0]))
         out = out.mul(film, axis=0)
     return out
-
-
-def _is_opaque_orientation(name: str) -> bool:
-    return name.startswith(f"{SOLAR_OPAQUE}_")
 
 
 def _solar_gains(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
@@ -273,7 +270,11 @@ def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
     (one function may compute several signals: it then runs once for all of them)."""
     return {
         **dict.fromkeys(solar_signal_names(building), _solar),
-        **dict.fromkeys(filter(_is_opaque_orientation, solar_signal_names(building)), _opaque_sun),
+        **{
+            name: _opaque_sun
+            for name in solar_signal_names(building)
+            if is_orientation_signal(name, SOLAR_OPAQUE)
+        },
         WIND_LOSS: _wind_loss,
         VENT_LOSS: _vent_loss,
         **{schedule_signal_name(name): _schedules for name in options.schedules},
