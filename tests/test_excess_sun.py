@@ -16,6 +16,7 @@ from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.candidates import CANDIDATES, Context
 from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.excess_sun import JUDGED_AFTER, capped_bounds, declared_g, held_to_glass
+from rcengine.diagnose.fitting import Fit
 from rcengine.models import get_model
 from rcengine.models.bounds import G_GLAZING_MAX
 from rcengine.signals import SignalOptions, prepare
@@ -93,3 +94,18 @@ def test_windows_within_glass_leave_the_walls_alone():
     assert report["baseline"]["parameters"]["g_window"] < G_GLAZING_MAX
     assert not any(f["accepted"] for f in report["findings"])
     assert report["skipped"]["opaque_solar_gains"] == JUDGED_AFTER
+
+
+def test_the_opaque_sun_must_be_preferred_by_the_bic_over_the_glazing_held_to_glass(
+    dark_walls, monkeypatch
+):
+    (finding,) = [f for f in dark_walls["findings"] if f["accepted"]]
+    assert finding["detail"]["excess_sun"]["delta_bic_capped_base"] < 0.0
+    assert "against them" in finding["reason"]
+    # The same record, had the opaque sun's fit been no better than its two parameters cost.
+    monkeypatch.setattr(Fit, "criteria_change", lambda self, simpler: {"aic": 1.0, "bic": 1.0})
+    report = diagnose(_record(2.0), SMALL, "basic", QUICK).to_dict()
+    (judged,) = [f for f in report["findings"] if f["effect"] == "opaque_solar_gains"]
+    assert not judged["accepted"]
+    assert "ΔBIC +1.0 against them" in judged["reason"]
+    assert report["verdict"].endswith("nothing missing")

@@ -106,6 +106,13 @@ class Fit:
             "bic": float(log_like + self.n_params * np.log(n_eff)),
         }
 
+    def criteria_change(self, simpler: Fit) -> dict[str, float]:
+        """ΔAIC and ΔBIC of this fit over ``simpler``, the model it extends, both counted with
+        ``simpler``'s effective n (negative: the criterion prefers this fit)."""
+        n_eff = simpler.n_eff
+        mine, theirs = self.information_criteria(n_eff), simpler.information_criteria(n_eff)
+        return {k: mine[k] - theirs[k] for k in ("aic", "bic")}
+
 
 def innovations(compiled: CompiledNetwork, params: dict[str, float], data: Dataset) -> np.ndarray:
     """One-step-ahead Kalman errors over every segment (each restarted from its first value)."""

@@ -119,9 +119,8 @@ def judge(
 ) -> Finding:
     """Accept an extension only for a meaningful test improvement that the BIC confirms."""
     before, after = current.rmse_test, fit.rmse_test
-    n_eff = current.n_eff
-    ic_before, ic_after = current.information_criteria(n_eff), fit.information_criteria(n_eff)
-    delta_bic = ic_after["bic"] - ic_before["bic"]
+    change = fit.criteria_change(current)
+    delta_bic = change["bic"]
     new = {p: fit.params[p] for p in ext.new_parameters}
     bounds = [p for p in fit.at_bounds if p in ext.new_parameters]
     idle = is_idle(ext, fit.params)
@@ -161,7 +160,7 @@ def judge(
         rmse_test_after=after,
         rmse_train_after=fit.rmse_train,
         delta_bic=delta_bic,
-        delta_aic=ic_after["aic"] - ic_before["aic"],
+        delta_aic=change["aic"],
         parameters=new,
         at_bounds=bounds,
         reason=reason,
