@@ -552,3 +552,30 @@ def test_a_candidate_left_out_is_exactly_the_model_it_extended(gain_context, eff
     assert compiled.input_names == base.input_names
     for a, b in zip(compiled.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_a_radiant_emitter_warms_the_mass_as_well_as_the_air(gain_context, loss_context):
+    """The emitter's alternative is a radiant surface: a second path to the interior mass, open
+    when absent, its share of the heat read against a heated ceiling's (the most radiant)."""
+    convective = _built("emitter_dynamics", gain_context, loss_context)
+    (radiant,) = convective.alternatives
+    assert radiant.new_parameters == ("c_emitter", "r_emitter", "r_emitter_mass")
+    paths = {(r.a, r.b) for r in radiant.network.resistors if r.resistance == "r_emitter_mass"}
+    assert paths == {("emitter", radiant.detail["radiant_to"])}
+    assert radiant.detail["radiant_to"] != radiant.network.output
+    without = radiant.network.fixed(radiant.absent)
+    assert sorted(without.states) == sorted(gain_context.network.states)
+    # A heated floor: convection 5.7 and radiation 5.1 W/(m²K) at its surface (EN 1264-2).
+    floor = {"c_emitter": 1.5e5, "r_emitter": 1 / 5.7, "r_emitter_mass": 1 / 5.1}
+    read = assess(radiant, {**TRUTH_BASIC, **floor})
+    assert read.plausible, read.problems
+    assert read.magnitudes["radiant_share"]["value"] == pytest.approx(5.1 / 10.8)
+    tau = read.magnitudes["emitter_time_constant"]["value"]
+    assert tau == pytest.approx(1.5e5 / 10.8 / 3600.0)
+    # Nearly all of it by radiation: no surface's convection is that weak.
+    mostly = assess(radiant, {**TRUTH_BASIC, **floor, "r_emitter": 1.0, "r_emitter_mass": 0.1})
+    assert mostly.problems == [
+        "share of the emitter's heat given to the interior mass (long-wave), at equal surface "
+        "temperatures: 0.909 exceeds any emitter (convector to heated floor or ceiling) "
+        "(≤ 0.857)"
+    ]

@@ -821,7 +821,9 @@ def thermal_mass(ctx: Context) -> Extension | Skipped:
 
 
 def emitter_dynamics(ctx: Context) -> Extension | Skipped:
-    """HVAC heat reaching the air through an emitter (radiator, slab) with its own inertia."""
+    """HVAC heat reaching the room through an emitter (radiator, radiant floor, slab) with its
+    own inertia: all of it to the air (a convector), and, where the model has an interior mass,
+    a radiant surface's, part of it to that mass (the alternative, ``_radiant_emitter``)."""
     effect = "emitter_dynamics"
     q = ctx.train[Q_HVAC].to_numpy(dtype=float) if Q_HVAC in ctx.train.columns else np.zeros(1)
     if not np.any(np.abs(q) > 0):
@@ -831,6 +833,15 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
     ]
     if not direct:
         return Skipped(effect, "q_hvac does not enter the air node directly in this model")
+    convective = _emitter(ctx)
+    if mass_node(ctx.network) == ctx.network.output:
+        return convective
+    return replace(convective, alternatives=(_radiant_emitter(ctx, convective),))
+
+
+def _emitter(ctx: Context) -> Extension:
+    """``emitter_dynamics`` giving all its heat to the air."""
+    effect = "emitter_dynamics"
     net = ctx.network.copy(_name(ctx.network, effect))
     floor = ctx.building.floor_area
     net.add_parameter(
@@ -863,6 +874,35 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
         neutral={"c_emitter": 1e2, "r_emitter": 1e-3},
         absent={"c_emitter": 0.0, "r_emitter": 0.0},
         detail={"node": "emitter", "floor_area_m2": floor},
+    )
+
+
+def _radiant_emitter(ctx: Context, convective: Extension) -> Extension:
+    """The emitter as a radiant surface (floor, ceiling, slab): besides its convection to the air
+    (r_emitter), long-wave exchange with the room's other surfaces, the interior mass
+    (r_emitter_mass). A radiator or fan coil gives nearly all its heat to the air; a heated floor
+    about half by radiation (EN 1264-2: 10.8 W/(m²K) at its surface, ε·4σT³ ≈ 5.1 of it), which
+    warms the mass before the air. Absent, the radiant path is open (r_emitter_mass = ∞)."""
+    net = convective.network.copy(convective.network.name)
+    mass = mass_node(ctx.network)
+    floor = ctx.building.floor_area
+    net.add_parameter(
+        Parameter(
+            "r_emitter_mass",
+            "m²K/W",
+            1e-3,
+            1e3,  # a path that passes almost nothing: the convector
+            "resistance between the emitter and the interior mass (long-wave), per floor area",
+        )
+    )
+    net.add_resistor("emitter", mass, "r_emitter_mass", factor=1.0 / floor)
+    return replace(
+        convective,
+        network=net,
+        new_parameters=(*convective.new_parameters, "r_emitter_mass"),
+        neutral={**convective.neutral, "r_emitter_mass": 1e3},
+        absent={**(convective.absent or {}), "r_emitter_mass": np.inf},
+        detail={**convective.detail, "radiant_to": mass},
     )
 
 

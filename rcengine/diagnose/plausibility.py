@@ -114,6 +114,10 @@ TABS_CAPACITY_J_M2K = TABS_SLAB_M * 2400.0 * 1000.0
 TABS_RESISTANCE_M2K_W = TABS_SLAB_M / 2.0 / 2.0 + 1.0 / 10.8
 # Emitter time constant: a fan coil or convector (minutes) to that slab (≈ 34 h). [h]
 EMITTER_TAU_H: Range = (0.05, TABS_CAPACITY_J_M2K * TABS_RESISTANCE_M2K_W / 3600.0)
+# Share of an emitter's heat given to the room's surfaces by long-wave radiation: none for a fan
+# coil, up to a heated ceiling's, whose convection is weakest (EN 1264-5: 6 W/(m²K) at its
+# surface, ε·4σT³ ≈ 5.1 of it radiant at ε 0.9 and 20 °C). [-]
+RADIANT_SHARE: Range = (0.0, 0.9 * 4.0 * STEFAN_BOLTZMANN * 293.15**3 / 6.0)
 # Emitter capacity per m² of floor, up to that slab's. [J/(m²K)]
 EMITTER_CAPACITY_J_M2K: Range = (0.0, TABS_CAPACITY_J_M2K)
 
@@ -420,6 +424,8 @@ def _mass(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 def _emitter(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     c, r = params["c_emitter"], params["r_emitter"]
+    # A radiant emitter's two paths in parallel set its time constant.
+    r_out = 1.0 / (1.0 / r + 1.0 / params.get("r_emitter_mass", float("inf")))
     return [
         Reading(
             "emitter_capacity",
@@ -431,11 +437,26 @@ def _emitter(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
         ),
         Reading(
             "emitter_time_constant",
-            c * r / 3600.0,
+            c * r_out / 3600.0,
             "h",
             "emitter time constant",
             EMITTER_TAU_H,
             "emitter (fan coil to thermally activated slab)",
+        ),
+        *(
+            [
+                Reading(
+                    "radiant_share",
+                    r / (r + params["r_emitter_mass"]),
+                    "-",
+                    "share of the emitter's heat given to the interior mass (long-wave), "
+                    "at equal surface temperatures",
+                    RADIANT_SHARE,
+                    "emitter (convector to heated floor or ceiling)",
+                )
+            ]
+            if "r_emitter_mass" in params
+            else []
         ),
     ]
 

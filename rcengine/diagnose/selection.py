@@ -501,6 +501,10 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
         if "ground_lag_months" in worse.detail:
             lag, how = worse.detail["ground_lag_months"], _version_words(worse)
             best.detail["ground_lag_not_taken"] = f"{lag:.1f} months ({how})"
+        if "radiant_to" in worse.detail:
+            best.detail["radiant_not_taken"] = _version_words(worse)
+        elif "radiant_to" in best.detail and worse.effect == "emitter_dynamics":
+            best.detail["convective_not_taken"] = _version_words(worse)
         chosen[f.effect] = best
     return list(chosen.values())
 
