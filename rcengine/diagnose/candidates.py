@@ -833,10 +833,10 @@ def emitter_dynamics(ctx: Context) -> Extension | Skipped:
     ]
     if not direct:
         return Skipped(effect, "q_hvac does not enter the air node directly in this model")
-    convective = _emitter(ctx)
-    if mass_node(ctx.network) == ctx.network.output:
+    convective, mass = _emitter(ctx), mass_node(ctx.network)
+    if mass == ctx.network.output:
         return convective
-    return replace(convective, alternatives=(_radiant_emitter(ctx, convective),))
+    return replace(convective, alternatives=(_radiant_emitter(ctx, convective, mass),))
 
 
 def _emitter(ctx: Context) -> Extension:
@@ -877,14 +877,14 @@ def _emitter(ctx: Context) -> Extension:
     )
 
 
-def _radiant_emitter(ctx: Context, convective: Extension) -> Extension:
+def _radiant_emitter(ctx: Context, convective: Extension, mass: str) -> Extension:
     """The emitter as a radiant surface (floor, ceiling, slab): besides its convection to the air
     (r_emitter), long-wave exchange with the room's other surfaces, the interior mass
     (r_emitter_mass). A radiator or fan coil gives nearly all its heat to the air; a heated floor
     about half by radiation (EN 1264-2: 10.8 W/(m²K) at its surface, ε·4σT³ ≈ 5.1 of it), which
-    warms the mass before the air. Absent, the radiant path is open (r_emitter_mass = ∞)."""
+    warms the mass before the air (``mass``, the model's interior mass node). Absent, the
+    radiant path is open (r_emitter_mass = ∞)."""
     net = convective.network.copy(convective.network.name)
-    mass = mass_node(ctx.network)
     floor = ctx.building.floor_area
     net.add_parameter(
         Parameter(

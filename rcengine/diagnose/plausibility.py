@@ -37,7 +37,7 @@ from rcengine.models.bounds import (
     U_OPAQUE,
 )
 from rcengine.models.physical import solar_apertures, steady_state_gains, ua
-from rcengine.signals.film import H_RE, STEFAN_BOLTZMANN
+from rcengine.signals.film import H_RE, radiative_coefficient
 from rcengine.signals.ground import ESTIMATE_Z
 
 if TYPE_CHECKING:
@@ -93,10 +93,7 @@ U_FLOOR: Range = (0.05, 1.0 / (1.0 / U_GROUND_MAX - R_SI[1]))
 GROUND_TEMPERATURE_MARGIN_K = 2.0
 # Long-wave coupling of an envelope surface to the sky, ε·h_r with h_r = 4σT³ (3.7 W/(m²K) at
 # −20 °C, 6.3 at 30 °C) and ε from bare metal (0.1) to paint, brick or roofing (0.95). [W/(m²K)]
-SKY_COUPLING: Range = (
-    0.1 * 4 * STEFAN_BOLTZMANN * 253.15**3,
-    0.95 * 4 * STEFAN_BOLTZMANN * 303.15**3,
-)
+SKY_COUPLING: Range = (radiative_coefficient(0.1, 253.15), radiative_coefficient(0.95, 303.15))
 # ε·h_r of a painted, brick or roofing surface (ε = 0.9) at 0 °C, the coupling at which the sky
 # candidate reads its fitted loss as a U-value: the outer film's radiative part. [W/(m²K)]
 SKY_H_R_TYPICAL = H_RE
@@ -117,7 +114,7 @@ EMITTER_TAU_H: Range = (0.05, TABS_CAPACITY_J_M2K * TABS_RESISTANCE_M2K_W / 3600
 # Share of an emitter's heat given to the room's surfaces by long-wave radiation: none for a fan
 # coil, up to a heated ceiling's, whose convection is weakest (EN 1264-5: 6 W/(m²K) at its
 # surface, ε·4σT³ ≈ 5.1 of it radiant at ε 0.9 and 20 °C). [-]
-RADIANT_SHARE: Range = (0.0, 0.9 * 4.0 * STEFAN_BOLTZMANN * 293.15**3 / 6.0)
+RADIANT_SHARE: Range = (0.0, radiative_coefficient(0.9, 293.15) / 6.0)
 # Emitter capacity per m² of floor, up to that slab's. [J/(m²K)]
 EMITTER_CAPACITY_J_M2K: Range = (0.0, TABS_CAPACITY_J_M2K)
 
@@ -425,8 +422,9 @@ def _mass(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 def _emitter(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     c, r = params["c_emitter"], params["r_emitter"]
     # A radiant emitter's two paths in parallel set its time constant.
-    r_out = 1.0 / (1.0 / r + 1.0 / params.get("r_emitter_mass", float("inf")))
-    return [
+    r_mass = params.get("r_emitter_mass", float("inf"))
+    r_out = 1.0 / (1.0 / r + 1.0 / r_mass)
+    readings = [
         Reading(
             "emitter_capacity",
             c / 1e3,
@@ -443,22 +441,20 @@ def _emitter(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             EMITTER_TAU_H,
             "emitter (fan coil to thermally activated slab)",
         ),
-        *(
-            [
-                Reading(
-                    "radiant_share",
-                    r / (r + params["r_emitter_mass"]),
-                    "-",
-                    "share of the emitter's heat given to the interior mass (long-wave), "
-                    "at equal surface temperatures",
-                    RADIANT_SHARE,
-                    "emitter (convector to heated floor or ceiling)",
-                )
-            ]
-            if "r_emitter_mass" in params
-            else []
-        ),
     ]
+    if "r_emitter_mass" in params:
+        readings.append(
+            Reading(
+                "radiant_share",
+                r / (r + r_mass),
+                "-",
+                "share of the emitter's heat given to the interior mass (long-wave), "
+                "at equal surface temperatures",
+                RADIANT_SHARE,
+                "emitter (convector to heated floor or ceiling)",
+            )
+        )
+    return readings
 
 
 READERS: dict[str, Callable[[Extension, Mapping[str, float]], list[Reading]]] = {

@@ -503,7 +503,7 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             best.detail["ground_lag_not_taken"] = f"{lag:.1f} months ({how})"
         if "radiant_to" in worse.detail:
             best.detail["radiant_not_taken"] = _version_words(worse)
-        elif "radiant_to" in best.detail and worse.effect == "emitter_dynamics":
+        elif "radiant_to" in best.detail:
             best.detail["convective_not_taken"] = _version_words(worse)
         chosen[f.effect] = best
     return list(chosen.values())

@@ -29,8 +29,15 @@ import numpy as np
 # The outer film taken as fixed at R_SE_SHELTERED, or varying with the data's wind.
 EXTERIOR_FILMS = ("fixed", "wind")
 STEFAN_BOLTZMANN = 5.670e-8  # [W/(m²K⁴)]
-# ε·h_r0 of a painted, brick or roofing surface (ε = 0.9) at 0 °C, h_r0 = 4σT³. [W/(m²K)]
-H_RE = 0.9 * 4 * STEFAN_BOLTZMANN * 273.15**3
+
+
+def radiative_coefficient(emissivity: float, t_k: float) -> float:
+    """ε·h_r, h_r = 4σT³: a surface's linearised long-wave exchange at ``t_k`` [K]. [W/(m²K)]"""
+    return emissivity * 4 * STEFAN_BOLTZMANN * t_k**3
+
+
+# ε·h_r0 of a painted, brick or roofing surface (ε = 0.9) at 0 °C. [W/(m²K)]
+H_RE = radiative_coefficient(0.9, 273.15)
 # Convection h_ce = H_CE_CALM + H_CE_PER_WIND·v (ISO 6946 Eq. C.4). [W/(m²K)], [W/(m²K) per m/s]
 H_CE_CALM, H_CE_PER_WIND = 4.0, 4.0
 # The wind of the sheltered film the fixed readings use (``R_SE_SHELTERED``). [m/s]
