@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -95,6 +96,16 @@ class Building:
     @classmethod
     def from_json(cls, path: str | Path) -> Building:
         return cls.from_dict(read_json(path, BuildingError))
+
+    @property
+    def footprint_area(self) -> float:
+        """The floor area on the ground: the horizontal projection Σ A·cos β of the opaque
+        surfaces facing up (tilt β < 90°, the roof), at most ``floor_area``; ``floor_area``
+        where ``walls`` lists no roof (one storey assumed). A multi-storey building stands on a
+        slab of its footprint, not of its total floor area (ISO 13370 §8.1: A, the ground
+        floor's area). [m²]"""
+        roof = sum(s.area * math.cos(math.radians(s.tilt)) for s in self.walls if s.tilt < 90.0)
+        return min(roof, self.floor_area) if roof > 0.0 else self.floor_area
 
     @property
     def notes(self) -> tuple[str, ...]:

@@ -254,6 +254,31 @@ def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
     assert [p for p in hot.problems if p.startswith("mean ground temperature")], hot.problems
 
 
+def test_a_building_stands_on_its_footprint():
+    """The ground floor is the roof's horizontal projection, not the total floor area: a second
+    storey doubles the floor area, not the slab; a pitched roof projects by cos β; without a
+    roof in the description one storey is assumed."""
+    storeys = replace(SMALL, floor_area=2 * SMALL.floor_area, volume=2 * SMALL.volume)
+    pitched = replace(SMALL, walls=(*SMALL.walls[:2], replace(SMALL.walls[2], tilt=30.0)))
+    unroofed = replace(SMALL, walls=SMALL.walls[:2])
+    assert SMALL.footprint_area == storeys.footprint_area == 120.0
+    assert pitched.footprint_area == pytest.approx(120.0 * np.cos(np.radians(30.0)))
+    assert unroofed.footprint_area == SMALL.floor_area
+
+
+def test_the_ground_couples_through_the_footprint(gain_context):
+    """U_floor is read per m² of the slab: on a two-storey building of the same footprint the
+    same r_floor is the same conductance, and the soil's constant heat the same power."""
+    storeys = replace(SMALL, floor_area=2 * SMALL.floor_area, volume=2 * SMALL.volume)
+    for building in (SMALL, storeys):
+        ext = CANDIDATES["ground_coupling"](replace(gain_context, building=building))
+        (floor,) = [r for r in ext.network.resistors if r.resistance == "r_floor"]
+        (soil,) = [h for h in ext.network.heat_inputs if h.gain == "q_ground"]
+        assert floor.factor == pytest.approx(1.0 / 120.0)
+        assert soil.factor == pytest.approx(120.0)
+        assert ext.detail["ground_floor_area_m2"] == 120.0
+
+
 @pytest.mark.parametrize(
     ("standard_error", "plausible", "implausible"), [(0.0, 7.5, 8.5), (1.5, 8.5, 11.5)]
 )

@@ -646,10 +646,12 @@ def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
 def ground_coupling(ctx: Context) -> Extension | Skipped:
     """Heat exchange through the floor with the soil under it, into the interior mass.
 
-    q = U_floor·A_floor·(T_base(t) + ΔT − T_mass), with U_floor = 1/r_floor and T_base the
-    outdoor annual cycle damped and lagged into the soil (``signals.ground``, signal t_ground);
-    the soil's warming by the building, ΔT, is fitted as the constant heat q_ground = U_floor·ΔT
-    per m² of floor on the ``unit`` signal, so the fitted ground temperature is T_base + q·r.
+    q = U_floor·A_floor·(T_base(t) + ΔT − T_mass), with U_floor = 1/r_floor, A_floor the
+    footprint (``Building.footprint_area``: the storeys above stand on the ground floor) and
+    T_base the outdoor annual cycle damped and lagged into the soil (``signals.ground``, signal
+    t_ground); the soil's warming by the building, ΔT, is fitted as the constant heat q_ground =
+    U_floor·ΔT per m² of ground floor on the ``unit`` signal, so the fitted ground temperature is
+    T_base + q·r.
     The lag depends on the floor's insulation, which the building description does not give:
     the soil is read at the model's lag (a month by default), and at ISO 13370's other lags
     (``GROUND_LAGS_S``) as alternatives.
@@ -672,7 +674,7 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
     ``soil`` (``_ground_temperatures`` at that depth)."""
     effect = "ground_coupling"
     net = ctx.network.copy(_name(ctx.network, effect))
-    floor = ctx.building.floor_area
+    footprint = ctx.building.footprint_area
     target = mass_node(net)
     net.add_parameter(
         Parameter(
@@ -680,7 +682,7 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
             "m²K/W",
             1.0 / (SEARCH_MARGIN * U_FLOOR[1]),
             SEARCH_MARGIN / U_FLOOR[0],
-            "resistance between the floor/interior mass and the soil, per floor area (1/U)",
+            "resistance between the floor/interior mass and the soil, per m² of ground floor (1/U)",
         )
     )
     net.add_parameter(
@@ -689,11 +691,11 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
             "W/m²",
             -20.0,
             60.0,
-            "constant heat from the soil's warming by the building, U·ΔT, per floor area",
+            "constant heat from the soil's warming by the building, U·ΔT, per m² of ground floor",
         )
     )
-    net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / floor)
-    net.add_heat_input(UNIT, target, "q_ground", factor=floor)
+    net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / footprint)
+    net.add_heat_input(UNIT, target, "q_ground", factor=footprint)
     return Extension(
         effect,
         net,
@@ -704,7 +706,7 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
         absent={"r_floor": np.inf, "q_ground": 0.0},
         detail={
             "node": target,
-            "floor_area_m2": floor,
+            "ground_floor_area_m2": footprint,
             "ground_depth_m": signals.ground_depth_m,
             "ground_lag_months": 12.0 * ground_lag(signals.ground_depth_m) / YEAR_S,
             **soil,
