@@ -22,6 +22,8 @@ from rcengine.network import Parameter, RCNetwork
 
 # The declared glazing's g-values: into the interior mass, and into the air directly.
 G_WINDOW, G_WINDOW_AIR = "g_window", "g_window_air"
+# The share of it absorbed by a storage a diagnosis added (``sun_on_added_mass``).
+G_WINDOW_ADDED_MASS = "g_window_mass_extra"
 # Steady air leakage the glazing conductance may also carry where the model has no other direct
 # path from the air to outdoors: a leaky building's infiltration (EN 12831-1 Table B.5). [1/h]
 LEAKAGE_ACH = 1.0
@@ -82,4 +84,26 @@ def with_declared_glazing(network: RCNetwork, building: Building, mass: str) -> 
             )
         )
         net.add_resistor(T_OUT, air, "r_window", factor=1.0 / area)
+    return net
+
+
+def sun_on_added_mass(network: RCNetwork, node: str) -> RCNetwork | None:
+    """``network`` with the declared glazing's sun falling on the storage ``node`` too, None
+    where the network takes no declared sun: exposed mass in a glazed room is one of the
+    surfaces the transmitted sun lands on (EnergyPlus spreads the transmitted diffuse sun over
+    the interior surfaces by area, ISO 52016-1 §6.5.13 likewise), so a storage added to the
+    network takes its own g-value of the glazing's sun, g_window_mass_extra × solar_window."""
+    if not has_declared_glazing(network) or G_WINDOW not in network.parameters:
+        return None
+    net = network.copy(network.name)
+    net.add_parameter(
+        Parameter(
+            G_WINDOW_ADDED_MASS,
+            "-",
+            0.0,
+            G_GLAZING_MAX,
+            "part of the declared glazing's g-value absorbed by the added storage",
+        )
+    )
+    net.add_heat_input(SOLAR_WINDOW, node, G_WINDOW_ADDED_MASS)
     return net

@@ -33,7 +33,12 @@ from typing import TYPE_CHECKING
 
 from rcengine.columns import SOLAR_WINDOW
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped
-from rcengine.diagnose.declared import G_WINDOW, G_WINDOW_AIR, has_declared_glazing
+from rcengine.diagnose.declared import (
+    G_WINDOW,
+    G_WINDOW_ADDED_MASS,
+    G_WINDOW_AIR,
+    has_declared_glazing,
+)
 from rcengine.diagnose.fitting import Fit, FitJob, fit_many
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import Finding, is_idle, judge, reject_implausible
@@ -46,7 +51,7 @@ if TYPE_CHECKING:
     from rcengine.diagnose.selection import Problem, Selection
 
 EFFECT = "opaque_solar_gains"
-DECLARED_G = (G_WINDOW, G_WINDOW_AIR)
+DECLARED_G = (G_WINDOW, G_WINDOW_AIR, G_WINDOW_ADDED_MASS)
 # Why the rounds leave the opaque sun out where glazing is declared (``state.skipped``).
 JUDGED_AFTER = (
     "judged once the selection has ended, from sun the declared glazing admits beyond glass"

@@ -33,7 +33,7 @@ from rcengine.columns import Q_HVAC, T_IN
 from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
 from rcengine.diagnose.day_ahead import day_ahead_block
-from rcengine.diagnose.declared import with_declared_glazing
+from rcengine.diagnose.declared import G_WINDOW_ADDED_MASS, sun_on_added_mass, with_declared_glazing
 from rcengine.diagnose.excess_sun import EFFECT as EXCESS_SUN_EFFECT
 from rcengine.diagnose.excess_sun import JUDGED_AFTER, attribute_excess_sun, has_glazing_g
 from rcengine.diagnose.fitting import (
@@ -298,6 +298,7 @@ def _repair(problem: Problem, state: Selection) -> None:
     finding.accepted, finding.baseline_repair = True, True
     finding.reason = f"taken to make the base model healthy ({finding.reason})"
     state.take(finding)
+    _settle_sun(problem, state, finding)
 
 
 def _judge(
@@ -370,6 +371,37 @@ def _select(problem: Problem, state: Selection) -> None:
         if best is None:
             break
         state.take(best)
+        if best.effect == "thermal_mass":
+            _settle_sun(problem, state, best)
+
+
+def _settle_sun(problem: Problem, state: Selection, finding: Finding) -> None:
+    """Once a storage is accepted, let the declared glazing's sun fall on it too
+    (``declared.sun_on_added_mass``), refitted from the accepted fit; kept where it fits the
+    training period better without forecasting the test period worse. The candidate itself
+    takes no sun: judged with it, a null's base model took a storage that re-timed its sun."""
+    node = finding.detail.get("node")
+    network = sun_on_added_mass(state.current.network, node) if node else None
+    if network is None:
+        return
+    current, settings = state.current, problem.settings
+    job = FitJob(
+        network,
+        current.options,
+        problem.split(network, current.options),
+        settings.preset,
+        settings.random_state,
+        [{**current.params, G_WINDOW_ADDED_MASS: 0.0}],
+    )
+    (fit,) = fit_many([job], settings.workers)
+    if fit.sse_train < current.sse_train and fit.rmse_test <= current.rmse_test:
+        problem.say(
+            f"  the added storage takes g = {fit.params[G_WINDOW_ADDED_MASS]:.2f} of the "
+            f"glazing's sun: test RMSE {current.rmse_test:.3f} → {fit.rmse_test:.3f} K"
+        )
+        finding.absent = {**finding.absent, G_WINDOW_ADDED_MASS: 0.0}
+        finding.detail["glazing_g_on_storage"] = fit.params[G_WINDOW_ADDED_MASS]
+        state.current, state.current_folds = fit, None
 
 
 def _extensions(problem: Problem, state: Selection) -> list[Extension]:
