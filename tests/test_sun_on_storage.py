@@ -78,3 +78,7 @@ def test_the_glazing_sun_on_an_added_storage_is_read_back():
     g_storage = accepted[0]["detail"]["glazing_g_on_storage"]
     assert g_storage == pytest.approx(SUN[G_WINDOW_ADDED_MASS], abs=0.15)
     assert report["final"]["parameters"][G_WINDOW_ADDED_MASS] == g_storage
+    assert (
+        f"the declared glazing's sun falls on it too: g = {g_storage:.2f}"
+        in (accepted[0]["explanation"])
+    )

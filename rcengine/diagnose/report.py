@@ -329,6 +329,8 @@ def _facts(finding: Finding) -> str:
         return f" ({faces})"
     if "schedule" in d:
         return f" (schedule learnt from the residuals: {d['schedule']})"
+    if "glazing_g_on_storage" in d:
+        return f" (the declared glazing's sun falls on it too: g = {d['glazing_g_on_storage']:.2f})"
     return ""
 
 
