@@ -558,7 +558,8 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     }
 
     # Screening is a linearisation; the first round refits every candidate for real, later
-    # rounds the ones whose earlier refit helped most.
+    # rounds the ``confirm`` most promising (all by default: a screen on a residual the fit has
+    # bent to take part of an effect underrates it, and left pairs' second effects unrefitted).
     def promise(e: Extension) -> tuple[float, float]:
         earlier = state.verdicts.get(e.effect)
         return (earlier.improvement_k if earlier else 0.0, screens[e.effect].explained)
