@@ -35,16 +35,23 @@ def _declared(frame: pd.DataFrame):
     return with_declared_glazing(get_model("basic", SMALL, frame.columns), SMALL, "int")
 
 
-def _record(au_walls: float) -> pd.DataFrame:
-    """Eight winter weeks of the small office whose walls pass α·U = ``au_walls`` W/(m²K) of
-    their sun (sol-air), simulated by the extended network."""
+def glazed_winter(truth: dict[str, float]) -> tuple[pd.DataFrame, Context]:
+    """Eight winter weeks of the small office (a twentieth of the synthetic heater, its gains
+    scaled to its floor area) and what a candidate is built from on its base model with the
+    declared glazing at ``truth``: the record an extended network is then simulated on."""
     frame = weather_and_gains(56, start="2017-01-02")
     frame = frame.assign(q_hvac=0.05 * frame["q_hvac"])
     for gain in ("q_occ", "q_light"):
         frame[gain] *= SMALL.floor_area / 1050.0
     base = _declared(frame)
     data = prepare(frame.assign(t_in=20.0), SMALL, base.compile().input_names)
-    ctx = Context(base, SMALL, data, SignalOptions(), TRUTH, np.zeros(len(data)))
+    return frame, Context(base, SMALL, data, SignalOptions(), truth, np.zeros(len(data)))
+
+
+def _record(au_walls: float) -> pd.DataFrame:
+    """Eight winter weeks of the small office whose walls pass α·U = ``au_walls`` W/(m²K) of
+    their sun (sol-air), simulated by the extended network."""
+    frame, ctx = glazed_winter(TRUTH)
     ext = CANDIDATES["opaque_solar_gains"](ctx)
     compiled = ext.network.compile()
     params = {**TRUTH, "au_opaque_walls": au_walls, "au_opaque_roof": 0.0}

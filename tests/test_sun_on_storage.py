@@ -14,12 +14,12 @@ import pandas as pd
 import pytest
 
 from rcengine.diagnose import DiagnoseSettings, diagnose
-from rcengine.diagnose.candidates import CANDIDATES, Context
-from rcengine.diagnose.declared import G_WINDOW_ADDED_MASS, sun_on_added_mass, with_declared_glazing
+from rcengine.diagnose.candidates import CANDIDATES
+from rcengine.diagnose.declared import G_WINDOW_ADDED_MASS, sun_on_added_mass
 from rcengine.models import get_model
-from rcengine.signals import SignalOptions, prepare
 from rcengine.simulate import simulate
 from tests.synthetic import TRUTH_BASIC, weather_and_gains
+from tests.test_excess_sun import glazed_winter
 from tests.test_plausibility import SMALL
 
 # 800 kJ/(m²K) of floor behind 0.02 m²K/W: more storage than the basic model's own can stand for.
@@ -29,34 +29,24 @@ SUN = {"g_window": 0.0, "g_window_air": 0.05, "r_window": 0.3, G_WINDOW_ADDED_MA
 TRUTH = {**TRUTH_BASIC, "alpha_wall": 1.0, "alpha_int": 0.0, **STORAGE, **SUN}
 
 
-def _declared(frame: pd.DataFrame):
-    return with_declared_glazing(get_model("basic", SMALL, frame.columns), SMALL, "int")
-
-
 def _record() -> pd.DataFrame:
     """Eight winter weeks of the small office with an exposed concrete storage taking the
     glazing's sun, simulated by the extended network."""
-    frame = weather_and_gains(56, start="2017-01-02")
-    frame = frame.assign(q_hvac=0.05 * frame["q_hvac"])
-    for gain in ("q_occ", "q_light"):
-        frame[gain] *= SMALL.floor_area / 1050.0
-    base = _declared(frame)
-    data = prepare(frame.assign(t_in=20.0), SMALL, base.compile().input_names)
-    ctx = Context(base, SMALL, data, SignalOptions(), TRUTH, np.zeros(len(data)))
+    frame, ctx = glazed_winter(TRUTH)
     ext = CANDIDATES["thermal_mass"](ctx)
     network = sun_on_added_mass(ext.network, ext.detail["node"])
     compiled = network.compile()
     rc = compiled.rc_matrices(compiled.as_theta(TRUTH)[:1])
-    u = data.inputs(compiled.input_names)
+    u = ctx.data.inputs(compiled.input_names)
     states = np.full((1, len(compiled.state_names)), 19.0)
-    return frame.assign(t_in=simulate(rc, u, states, data.step_s)[0])
+    return frame.assign(t_in=simulate(rc, u, states, ctx.data.step_s)[0])
 
 
 def test_the_sun_falls_on_the_added_storage_only_where_glazing_is_declared():
     frame = weather_and_gains(7)
     bare = get_model("basic", SMALL, frame.columns)
     assert sun_on_added_mass(bare, "int") is None
-    glazed = sun_on_added_mass(_declared(frame), "int")
+    glazed = sun_on_added_mass(glazed_winter(TRUTH)[1].network, "int")
     assert G_WINDOW_ADDED_MASS in glazed.parameters
     (sun,) = [h for h in glazed.heat_inputs if h.gain == G_WINDOW_ADDED_MASS]
     assert (sun.signal, sun.node) == ("solar_window", "int")
