@@ -39,6 +39,12 @@ def has_declared_glazing(network: RCNetwork) -> bool:
     return SOLAR_WINDOW in network.signals
 
 
+def has_glazing_g(network: RCNetwork) -> bool:
+    """Whether the network takes the sun through declared glazing with a fitted g-value (the
+    base model given the description's windows, ``with_declared_glazing``)."""
+    return has_declared_glazing(network) and G_WINDOW in network.parameters
+
+
 def with_declared_glazing(network: RCNetwork, building: Building, mass: str) -> RCNetwork:
     """``network`` with the building's declared windows (a copy; the network itself when it has
     them already or none are declared).
@@ -93,7 +99,7 @@ def sun_on_added_mass(network: RCNetwork, node: str) -> RCNetwork | None:
     surfaces the transmitted sun lands on (EnergyPlus spreads the transmitted diffuse sun over
     the interior surfaces by area, ISO 52016-1 §6.5.13 likewise), so a storage added to the
     network takes its own g-value of the glazing's sun, g_window_mass_extra × solar_window."""
-    if not has_declared_glazing(network) or G_WINDOW not in network.parameters:
+    if not has_glazing_g(network):
         return None
     net = network.copy(network.name)
     net.add_parameter(

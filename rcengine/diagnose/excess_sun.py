@@ -37,7 +37,7 @@ from rcengine.diagnose.declared import (
     G_WINDOW,
     G_WINDOW_ADDED_MASS,
     G_WINDOW_AIR,
-    has_declared_glazing,
+    has_glazing_g,
 )
 from rcengine.diagnose.fitting import Fit, FitJob, fit_many
 from rcengine.diagnose.plausibility import assess
@@ -56,12 +56,6 @@ DECLARED_G = (G_WINDOW, G_WINDOW_AIR, G_WINDOW_ADDED_MASS)
 JUDGED_AFTER = (
     "judged once the selection has ended, from sun the declared glazing admits beyond glass"
 )
-
-
-def has_glazing_g(network: RCNetwork) -> bool:
-    """Whether the network takes the sun through declared glazing with a fitted g-value (the
-    base model given the description's windows, ``declared``)."""
-    return has_declared_glazing(network) and G_WINDOW in network.parameters
 
 
 def declared_g(network: RCNetwork, params: dict[str, float]) -> float | None:

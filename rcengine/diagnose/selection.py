@@ -33,9 +33,14 @@ from rcengine.columns import Q_HVAC, T_IN
 from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
 from rcengine.diagnose.day_ahead import day_ahead_block
-from rcengine.diagnose.declared import G_WINDOW_ADDED_MASS, sun_on_added_mass, with_declared_glazing
+from rcengine.diagnose.declared import (
+    G_WINDOW_ADDED_MASS,
+    has_glazing_g,
+    sun_on_added_mass,
+    with_declared_glazing,
+)
 from rcengine.diagnose.excess_sun import EFFECT as EXCESS_SUN_EFFECT
-from rcengine.diagnose.excess_sun import JUDGED_AFTER, attribute_excess_sun, has_glazing_g
+from rcengine.diagnose.excess_sun import JUDGED_AFTER, attribute_excess_sun
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -371,17 +376,17 @@ def _select(problem: Problem, state: Selection) -> None:
         if best is None:
             break
         state.take(best)
-        if best.effect == "thermal_mass":
-            _settle_sun(problem, state, best)
+        _settle_sun(problem, state, best)
 
 
 def _settle_sun(problem: Problem, state: Selection, finding: Finding) -> None:
-    """Once a storage is accepted, let the declared glazing's sun fall on it too
+    """Once a storage (``thermal_mass``) is accepted, let the declared glazing's sun fall on it too
     (``declared.sun_on_added_mass``), refitted from the accepted fit; kept where it fits the
     training period better without forecasting the test period worse. The candidate itself
     takes no sun: judged with it, a null's base model took a storage that re-timed its sun."""
-    node = finding.detail.get("node")
-    network = sun_on_added_mass(state.current.network, node) if node else None
+    if finding.effect != "thermal_mass":
+        return
+    network = sun_on_added_mass(state.current.network, finding.detail["node"])
     if network is None:
         return
     current, settings = state.current, problem.settings
