@@ -286,14 +286,15 @@ def test_the_dew_point_sky_follows_the_weather_files_infrared(shared_data):
 
 
 def test_each_deriver_runs_once_for_all_its_signals(project_data, monkeypatch):
-    """Every derivable signal in one request: each function runs once, and every column equals
+    """Every derivable signal in one request: each function runs once — the sun too, for the
+    summed and the per-orientation signals, the windows' and the walls' — and every column equals
     the one it gives when asked alone (wind_loss and vent_loss share no work, so they are not
     computed twice)."""
     office = project_data / "energyplus" / "office"
     building = Building.from_json(office / "building.json")
     frame = read_timeseries(office / "heating.csv").iloc[: 3 * 96]
     week = np.tile(np.r_[np.zeros(8), np.ones(10), np.zeros(6)], 7).tolist()
-    options = SignalOptions(schedules={VENT_SCHEDULE: week, "gains": week})
+    options = SignalOptions(schedules={VENT_SCHEDULE: week, "gains": week}, exterior_film="wind")
     names = list(derivers(building, options))
     assert {WIND_LOSS, VENT_LOSS, schedule_signal_name("gains")} <= set(names)
     alone = {n: derive(frame, building, [n], options)[n] for n in names}
@@ -302,13 +303,13 @@ def test_each_deriver_runs_once_for_all_its_signals(project_data, monkeypatch):
     def counted(name: str):
         function = getattr(rcengine.signals.derived, name)
 
-        def wrapper(*args):
+        def wrapper(*args, **kwargs):
             calls[name] = calls.get(name, 0) + 1
-            return function(*args)
+            return function(*args, **kwargs)
 
         return wrapper
 
-    for function in {f.__name__ for f in derivers(building, options).values()}:
+    for function in {f.__name__ for f in derivers(building, options).values()} | {"solar_gains"}:
         monkeypatch.setattr(rcengine.signals.derived, function, counted(function))
     together = derive(frame, building, names, options)
     assert sorted(together.columns) == sorted(names)

@@ -7,7 +7,7 @@ simulates, used by the CLI, the study and the service alike.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -146,28 +146,20 @@ _CHOICES = {
     "exterior_film": EXTERIOR_FILMS,
 }
 
-Deriver = Callable[[pd.DataFrame, Building, SignalOptions], pd.DataFrame]
+Deriver = Callable[[pd.DataFrame, Building, SignalOptions, Sequence[str]], pd.DataFrame]
+"""A deriver's arguments: the validated frame, the building, the options and the names asked of
+it (one deriver computes a family of signals, once for all; some need a column only for some
+names). It returns at least the names asked."""
 
 
-def _solar(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """The solar signals (``signals.solar``); each orientation's opaque sun is ``_opaque_sun``'s."""
-    return _solar_gains(frame, building, options)
-
-
-def _opaque_sun(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    """Each orientation's opaque sun ``solar_opaque_<k>`` [W] through the outer film of
-    ``options.exterior_film``: one that follows the wind needs the data's ``wind_speed``, and only
-    a model taking these signals does (the thesis's summed ``solar_opaque`` is ``_solar``'s)."""
-    out = _solar_gains(frame, building, options)
-    out = out[[c for c in out.columns if is_orientation_signal(c, SOLAR_OPAQUE)]]
-    if options.exterior_film == "wind" and len(out.columns):
-        film = film_factor(_require(frame, WIND_SPEED, out.columns[0]))
-        out = out.mul(film, axis=0)
-    return out
-
-
-def _solar_gains(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
-    return solar_gains(
+def _solar(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
+    """The solar signals (``signals.solar``), computed once for all of them. Each orientation's
+    opaque sun ``solar_opaque_<k>`` [W] passes the outer film of ``options.exterior_film``: one
+    that follows the wind needs the data's ``wind_speed``, and only a model taking these signals
+    does (the thesis's summed ``solar_opaque`` keeps the sheltered film)."""
+    out = solar_gains(
         frame,
         building,
         sky_model=options.sky_model,
@@ -175,6 +167,11 @@ def _solar_gains(frame: pd.DataFrame, building: Building, options: SignalOptions
         iam_model=options.iam_model,
         decomposition=options.decomposition,
     )
+    opaque = [c for c in wanted if is_orientation_signal(c, SOLAR_OPAQUE)]
+    if options.exterior_film == "wind" and opaque:
+        film = film_factor(_require(frame, WIND_SPEED, opaque[0]))
+        out[opaque] = out[opaque].mul(film, axis=0)
+    return out
 
 
 def _require(frame: pd.DataFrame, column: str, signal: str) -> np.ndarray:
@@ -206,7 +203,9 @@ def mask_measured(frame: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
     return masked
 
 
-def _wind_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+def _wind_loss(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
     """wind_loss = wind_speed · (t_out − t_in) (``indoor_operating_point``). [m/s·K]"""
     t_out = frame[T_OUT].to_numpy(dtype=float)
     wind = _require(frame, WIND_SPEED, WIND_LOSS)
@@ -214,7 +213,9 @@ def _wind_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) 
     return pd.DataFrame({WIND_LOSS: loss}, index=frame.index)
 
 
-def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+def _vent_loss(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
     """vent_loss = vent schedule · (t_out − t_in) (``indoor_operating_point``). [K]"""
     if VENT_SCHEDULE not in options.schedules:
         raise ModelError(f"signal '{VENT_LOSS}' needs a '{VENT_SCHEDULE}' schedule")
@@ -227,7 +228,9 @@ def _vent_loss(frame: pd.DataFrame, building: Building, options: SignalOptions) 
     return pd.DataFrame({VENT_LOSS: loss}, index=frame.index)
 
 
-def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+def _schedules(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
     """sched_<name>: a stored weekly schedule played back on its clock. [-]"""
     tz = options.schedule_zone(building)
     closed = closed_weekdays(frame, tz)
@@ -240,7 +243,9 @@ def _schedules(frame: pd.DataFrame, building: Building, options: SignalOptions) 
     )
 
 
-def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+def _ground(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
     """t_ground: the outdoor annual cycle damped and lagged into the soil [°C] (its mean is
     fitted on top, through a constant heat input on ``unit``); unit = 1 [-]."""
     t_out = frame[T_OUT].to_numpy(dtype=float)
@@ -257,7 +262,9 @@ def _ground(frame: pd.DataFrame, building: Building, options: SignalOptions) -> 
     )
 
 
-def _sky(frame: pd.DataFrame, building: Building, options: SignalOptions) -> pd.DataFrame:
+def _sky(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
     """sky_delta = T_sky − t_out [K]: the long-wave driving temperature difference to the sky."""
     if options.cloud_cover == "column":
         _require(frame, CLOUD_COVER, SKY_DELTA)
@@ -270,11 +277,6 @@ def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
     (one function may compute several signals: it then runs once for all of them)."""
     return {
         **dict.fromkeys(solar_signal_names(building), _solar),
-        **{
-            name: _opaque_sun
-            for name in solar_signal_names(building)
-            if is_orientation_signal(name, SOLAR_OPAQUE)
-        },
         WIND_LOSS: _wind_loss,
         VENT_LOSS: _vent_loss,
         **{schedule_signal_name(name): _schedules for name in options.schedules},
@@ -294,7 +296,7 @@ def derive(
     for deriver in dict.fromkeys(by_name.values()):
         family = [n for n in wanted if by_name.get(n) is deriver]
         if family:
-            out = out.join(deriver(frame, building, options)[family])
+            out = out.join(deriver(frame, building, options, family)[family])
     unknown = [n for n in wanted if n not in out.columns]
     if unknown:
         absent = [n for n in unknown if n in NUMERIC_COLUMNS]
