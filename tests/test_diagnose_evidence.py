@@ -68,6 +68,11 @@ def test_verdict_says_the_base_model_is_inadequate_and_what_was_found_against_it
     text = verdict([repair, wind], CRIPPLED)
     assert text.endswith("— healthy with thermal_mass, then missing: wind_infiltration"), text
     assert verdict([repair], CRIPPLED).endswith("healthy with thermal_mass, then nothing missing")
+    # Dropped after the selection, the later findings having healed the base model.
+    repair.accepted = False
+    text = verdict([wind, repair], CRIPPLED)
+    healed = "healthy once what it left out is in (thermal_mass not needed)"
+    assert text.endswith(f"— {healed}: missing: wind_infiltration"), text
 
 
 def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():

@@ -20,7 +20,7 @@ from rcengine.diagnose.folds import (
     rolling_folds,
 )
 from rcengine.diagnose.report import Finding
-from rcengine.diagnose.selection import Selection, _backward, _one_version_each
+from rcengine.diagnose.selection import Selection, _backward, _one_version_each, _recheck_repair
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
 from rcengine.network import Parameter, RCNetwork
@@ -201,6 +201,80 @@ def test_the_backward_check_drops_a_stand_in_the_later_finding_made_redundant(mo
     assert state.calls == [["unmetered_gains", "emitter_dynamics"]]  # one left: no second check
     emitter = state.accepted[1]
     assert emitter.backward["still_needed"] and emitter.backward["helped"] == 4
+
+
+def _repair_check(
+    without: list[float], healthy_without: bool, monkeypatch, later: tuple[str, ...] = ("sky",)
+) -> Selection:
+    """The repair step checked after the selection on made-up fold errors: the folds' test RMSE
+    without it ``without`` (with it: 0.5 K in every fold), the model without it healthy or not;
+    ``later`` the findings accepted after it."""
+    calls = []
+
+    def without_each(problem, state, judged):
+        calls.append([f.effect for f in judged])
+        reduced = [(f"final without {f.effect}", f"folds without {f.effect}") for f in judged]
+        return reduced, [_evidence(without, [0.5] * len(without)) for _ in judged]
+
+    health = SimpleNamespace(healthy=healthy_without)
+    monkeypatch.setattr(selection, "_without_each", without_each)
+    monkeypatch.setattr(selection, "_health", lambda problem, fit: (None, health))
+    start = pd.Timestamp("2017-01-02", tz="UTC")
+    folds = [Fold(k, start, start + 28 * DAY, start + 42 * DAY) for k in range(len(without))]
+    problem = SimpleNamespace(
+        folds=folds,
+        settings=SimpleNamespace(fold_rule=FoldRule()),
+        building=SimpleNamespace(location=SimpleNamespace(timezone=TZ)),
+        say=lambda message: None,
+    )
+    accepted = [_accepted(e, k + 1) for k, e in enumerate(later)]
+    state = Selection(current="final", accepted=[_accepted("thermal_mass", 0, True), *accepted])
+    _recheck_repair(problem, state)
+    state.calls = calls
+    return state
+
+
+def test_a_repair_the_later_findings_made_redundant_is_dropped(monkeypatch):
+    # Without the storage the final model is healthy and forecasts the folds as well (0.51 K
+    # against 0.5): the storage stood in for what the sky explains.
+    state = _repair_check([0.51, 0.5, 0.49, 0.51], True, monkeypatch)
+    assert [f.effect for f in state.accepted] == ["sky"]
+    dropped = state.verdicts["thermal_mass"]
+    assert not dropped.accepted and dropped.baseline_repair
+    assert dropped.reason.startswith("dropped once the later findings were in")
+    assert dropped.backward["still_needed"] is False and dropped.backward["healthy_without"]
+    assert (state.current, state.current_folds) == (
+        "final without thermal_mass",
+        "folds without thermal_mass",
+    )
+
+
+def test_a_repair_the_bounds_still_need_stays_but_after_the_findings(monkeypatch):
+    # Without the storage the model is still inadequate: it stays in the model, but the data do
+    # not show it missing (0.51 K against 0.5 across the folds), so the sky is the answer.
+    state = _repair_check([0.51, 0.5, 0.49, 0.51], False, monkeypatch)
+    assert [(f.effect, f.accepted) for f in state.accepted] == [
+        ("sky", True),
+        ("thermal_mass", True),
+    ]
+    repair = state.accepted[1]
+    assert "kept for the base model's bounds, listed after the findings" in repair.reason
+    assert repair.backward["still_needed"] and not repair.backward["healthy_without"]
+    assert state.current == "final" and not state.verdicts
+
+
+@pytest.mark.parametrize(
+    ("without", "later"),
+    [
+        ([0.8, 0.7, 0.9, 0.8], ("sky",)),  # helps in every fold: a storage is missing
+        ([0.51, 0.5, 0.49, 0.51], ()),  # nothing found after it: not checked
+    ],
+)
+def test_a_repair_that_helps_stays_first(monkeypatch, without, later):
+    state = _repair_check(without, True, monkeypatch, later)
+    assert [f.effect for f in state.accepted] == ["thermal_mass", *later]
+    assert state.current == "final" and not state.verdicts
+    assert state.calls == ([["thermal_mass"]] if later else [])
 
 
 def test_the_backward_check_orders_the_findings_by_what_leaving_each_out_costs(monkeypatch):

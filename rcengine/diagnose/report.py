@@ -300,11 +300,13 @@ def verdict(findings: list[Finding], health: Health | None) -> str:
     if health is None or health.healthy:
         return found
     repairs = [f.effect for f in findings if f.accepted and f.baseline_repair]
-    against = (
-        f"healthy with {', '.join(repairs)}, then {found}"
-        if repairs
-        else f"judged against it anyway: {found}"
-    )
+    dropped = [f.effect for f in findings if not f.accepted and f.baseline_repair]
+    if repairs:
+        against = f"healthy with {', '.join(repairs)}, then {found}"
+    elif dropped:
+        against = f"healthy once what it left out is in ({', '.join(dropped)} not needed): {found}"
+    else:
+        against = f"judged against it anyway: {found}"
     return f"base model inadequate: {'; '.join(health.reasons)} — {against}"
 
 
