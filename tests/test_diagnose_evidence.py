@@ -4,6 +4,7 @@ that both pass, and the base model's health in the report (issue 11, items 2, 4 
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -12,7 +13,7 @@ import pytest
 from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.folds import FoldEvidence, rolling_folds
 from rcengine.diagnose.health import Health
-from rcengine.diagnose.html import render
+from rcengine.diagnose.html import _residual_before, render
 from rcengine.diagnose.report import Finding, confirm_on_folds, reject_implausible, verdict
 from rcengine.diagnose.selection import MIN_HVAC_SHARE, _informative, _winner
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
@@ -168,3 +169,20 @@ def test_a_baseline_no_better_than_a_constant_gives_the_inadequate_verdict(gain_
     assert health["rmse_test"] > health["naive_rmse_test"]["constant"]
     assert d["verdict"].startswith("base model inadequate: test RMSE")
     assert "missing: unmetered_gains" in d["verdict"]
+
+
+def test_a_findings_figure_shows_the_residual_of_the_round_it_was_judged_in():
+    """The accepted findings are listed by strength of evidence, not by round: a finding's
+    screening figure is drawn against the fit of the one accepted in the latest earlier round
+    (the base model's before round one; a repair is round 0)."""
+    baseline = SimpleNamespace(residual_train="base model")
+    repair = _finding("thermal_mass", True, round=0, baseline_repair=True)
+    first, second = _finding("sky_radiation", True, round=1), _finding("wind", True, round=2)
+    for f in (repair, first, second):
+        f.fit = SimpleNamespace(residual_train=f"after {f.effect}")
+    report = SimpleNamespace(baseline=baseline, accepted=[second, first, repair])
+    assert _residual_before(report, second) == "after sky_radiation"
+    assert _residual_before(report, first) == "after thermal_mass"
+    assert _residual_before(report, repair) == "base model"
+    late = _finding("ground_coupling", False, round=3)
+    assert _residual_before(report, late) == "after wind"

@@ -129,9 +129,11 @@ def evidence_figure(report: Report, finding: Finding) -> plt.Figure | None:
 
 def _residual_before(report: Report, finding: Finding) -> np.ndarray:
     # The residual the candidate was screened against: the model of the round it was judged in,
-    # the base model extended by every finding accepted in an earlier round (a repair is round 0).
-    fits = [report.baseline] + [f.fit for f in report.accepted]
-    return fits[sum(f.round < finding.round for f in report.accepted)].residual_train
+    # the fit of the finding accepted in the latest earlier round (a repair is round 0). Found
+    # by round, not by place: the accepted findings are listed by strength of evidence.
+    earlier = [f for f in report.accepted if f.round < finding.round]
+    fit = max(earlier, key=lambda f: f.round).fit if earlier else report.baseline
+    return fit.residual_train
 
 
 def save_figures(report: Report, folder: Path, stem: str) -> list[Path]:
