@@ -19,7 +19,7 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
-from rcengine.diagnose.report import Finding
+from rcengine.diagnose.report import Finding, explain
 from rcengine.diagnose.selection import Selection, _backward, _one_version_each, _recheck_repair
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
@@ -260,6 +260,13 @@ def test_a_repair_the_bounds_still_need_stays_but_after_the_findings(monkeypatch
     repair = state.accepted[1]
     assert "kept for the base model's bounds, listed after the findings" in repair.reason
     assert repair.backward["still_needed"] and not repair.backward["healthy_without"]
+    assert repair.backward["helps_on_folds"] is False
+    repair.detail, repair.parameters = {}, {}
+    repair.rmse_test_after = repair.rmse_train_after = 1.0
+    assert explain(repair, "").startswith(
+        "The base model cannot represent this building without it, but once the findings above "
+        "are in the data do not show it missing. It adds a heat-storage"
+    )
     assert state.current == "final" and not state.verdicts
 
 

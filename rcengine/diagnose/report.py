@@ -262,13 +262,16 @@ def explain(finding: Finding, pattern: str) -> str:
     removed = 1.0 - (finding.rmse_train_after / finding.rmse_train_before) ** 2
     correction = finding.detail.get("correction", "")
     if finding.accepted:
-        repair = (
-            "The base model cannot represent this building without it. "
-            if finding.baseline_repair
-            else ""
-        )
+        lead = f"The model left out {what}"
+        if finding.baseline_repair:
+            lead = f"The base model cannot represent this building without it. {lead}"
+        if finding.baseline_repair and not (finding.backward or {}).get("helps_on_folds", True):
+            lead = (
+                "The base model cannot represent this building without it, but once the "
+                f"findings above are in the data do not show it missing. It adds {what}"
+            )
         return (
-            f"{repair}The model left out {what}. Where and when: {pattern}; {correction}{facts}. "
+            f"{lead}. Where and when: {pattern}; {correction}{facts}. "
             f"Adding it ({_values(finding)}) removes {max(removed, 0.0):.0%} of the training "
             f"error and cuts the test RMSE from {finding.rmse_test_before:.2f} to "
             f"{finding.rmse_test_after:.2f} K{_across(finding)}."

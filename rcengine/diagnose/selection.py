@@ -723,6 +723,7 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
         **evidence.to_dict(problem.folds, problem.building.location.timezone),
         "still_needed": helps or not health.healthy,
         "reason": f"added last, to the other findings: {text}",
+        "helps_on_folds": helps,
         "healthy_without": health.healthy,
     }
     if helps:
