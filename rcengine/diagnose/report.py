@@ -263,13 +263,13 @@ def explain(finding: Finding, pattern: str) -> str:
     correction = finding.detail.get("correction", "")
     if finding.accepted:
         lead = f"The model left out {what}"
-        if finding.baseline_repair:
-            lead = f"The base model cannot represent this building without it. {lead}"
         if finding.baseline_repair and not (finding.backward or {}).get("helps_on_folds", True):
             lead = (
                 "The base model cannot represent this building without it, but once the "
                 f"findings above are in the data do not show it missing. It adds {what}"
             )
+        elif finding.baseline_repair:
+            lead = f"The base model cannot represent this building without it. {lead}"
         return (
             f"{lead}. Where and when: {pattern}; {correction}{facts}. "
             f"Adding it ({_values(finding)}) removes {max(removed, 0.0):.0%} of the training "

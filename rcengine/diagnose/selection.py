@@ -675,7 +675,7 @@ def _backward(problem: Problem, state: Selection) -> None:
     but not dropped by them; it is checked after it too, since a finding taken before it may
     have stood in for its sun.
     """
-    rule, timezone = problem.settings.fold_rule, problem.building.location.timezone
+    rule = problem.settings.fold_rule
     while problem.folds:
         judged = [f for f in state.accepted if not f.baseline_repair]
         if len(judged) < 2:
@@ -687,8 +687,7 @@ def _backward(problem: Problem, state: Selection) -> None:
         for finding, ev in zip(judged, evidence, strict=True):
             ok, text = judge_folds(ev, rule)
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
-            finding.backward = {**ev.to_dict(problem.folds, timezone), "still_needed": ok}
-            finding.backward["reason"] = f"added last, to the other findings: {text}"
+            finding.backward = _added_last(problem, ev, text, still_needed=ok)
             if not ok and finding.evidence is not None:
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
@@ -719,13 +718,14 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
     ((fit, fold_fits),), (evidence,) = _without_each(problem, state, [repair])
     _, health = _health(problem, fit)
     helps, text = judge_folds(evidence, problem.settings.fold_rule)
-    repair.backward = {
-        **evidence.to_dict(problem.folds, problem.building.location.timezone),
-        "still_needed": helps or not health.healthy,
-        "reason": f"added last, to the other findings: {text}",
-        "helps_on_folds": helps,
-        "healthy_without": health.healthy,
-    }
+    repair.backward = _added_last(
+        problem,
+        evidence,
+        text,
+        still_needed=helps or not health.healthy,
+        helps_on_folds=helps,
+        healthy_without=health.healthy,
+    )
     if helps:
         return
     state.accepted.remove(repair)
@@ -742,6 +742,13 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
     )
     state.verdicts[repair.effect] = repair
     state.current, state.current_folds = fit, fold_fits
+
+
+def _added_last(problem: Problem, evidence: FoldEvidence, text: str, **verdict: bool) -> dict:
+    """A finding's ``backward`` record: the folds' evidence of it added last to the others, what
+    the fold rule said (``text``) and the check's verdict."""
+    record = evidence.to_dict(problem.folds, problem.building.location.timezone)
+    return {**record, **verdict, "reason": f"added last, to the other findings: {text}"}
 
 
 def _without_each(
