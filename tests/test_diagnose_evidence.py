@@ -119,9 +119,8 @@ def test_of_two_passing_candidates_the_head_to_head_winner_is_taken_and_the_othe
         rmse_test_after=0.4,  # better on the single split
         evidence=_evidence([1, 1, 1], [0.8, 0.6, 0.9]),
     )
-    verdicts = {"opaque_solar_gains": opaque, "window_solar_gains": window}
-    best = _winner([opaque, window], verdicts, 1)
-    assert best is window and list(verdicts) == ["opaque_solar_gains"]
+    best = _winner([opaque, window], 1)
+    assert best is window and window.accepted
     assert not opaque.accepted and opaque.lost_to["effect"] == "window_solar_gains"
     assert "better in 1 of 3 folds" in opaque.lost_to["reason"]
     assert opaque.reason.startswith("not taken in round 1: lost to window_solar_gains")

@@ -3,10 +3,13 @@
 The small office declares its windows; its dark facades' sun is concealed. Fitted without it,
 the base model lets the windows admit more sun than glass can; held to glass, the opaque sun
 carries the rest, with the declared glazing's g-value and the walls' α·U recovered. Where the
-windows stay within glass, the opaque sun is not taken.
+windows stay within glass, the opaque sun is not taken. In the rounds, where glazing is declared,
+it is named only against another effect that passes.
 """
 
 from __future__ import annotations
+
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -15,8 +18,9 @@ import pytest
 from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.candidates import CANDIDATES, Context
 from rcengine.diagnose.declared import with_declared_glazing
-from rcengine.diagnose.excess_sun import JUDGED_AFTER, capped_bounds, declared_g, held_to_glass
+from rcengine.diagnose.excess_sun import RIVAL_ONLY, capped_bounds, declared_g, held_to_glass
 from rcengine.diagnose.fitting import Fit
+from rcengine.diagnose.selection import _unrivalled
 from rcengine.models import get_model
 from rcengine.models.bounds import G_GLAZING_MAX
 from rcengine.signals import SignalOptions, prepare
@@ -94,13 +98,37 @@ def test_sun_beyond_glass_is_found_on_the_opaque_walls(dark_walls):
     assert finding["reason"].startswith("accepted: the declared glazing admitted g = ")
     assert dark_walls["verdict"].endswith("missing: opaque_solar_gains")
     assert "opaque_solar_gains" not in dark_walls["skipped"]
+    # The round's verdict on it (a rival with nothing else passing) gives way to the finding.
+    assert [f["effect"] for f in dark_walls["findings"]] == ["opaque_solar_gains"]
 
 
 def test_windows_within_glass_leave_the_walls_alone():
     report = diagnose(_record(0.0), SMALL, "basic", QUICK).to_dict()
     assert report["baseline"]["parameters"]["g_window"] < G_GLAZING_MAX
     assert not any(f["accepted"] for f in report["findings"])
-    assert report["skipped"]["opaque_solar_gains"] == JUDGED_AFTER
+    assert "opaque_solar_gains" not in report["skipped"]  # judged in the round as a rival
+
+
+def _verdict(effect: str, accepted: bool) -> SimpleNamespace:
+    reason = "accepted: test RMSE 0.50 → 0.40 K (-20%)" if accepted else "rejected: ΔBIC +3.0"
+    return SimpleNamespace(effect=effect, accepted=accepted, reason=reason)
+
+
+def test_the_opaque_sun_is_named_in_a_round_only_against_another_effect_that_passes():
+    alone = [_verdict("opaque_solar_gains", True), _verdict("wind_infiltration", False)]
+    _unrivalled(alone, {"opaque_solar_gains"})
+    assert not alone[0].accepted
+    assert alone[0].reason.startswith("passed its own margins (test RMSE 0.50 → 0.40 K (-20%))")
+    assert alone[0].reason.endswith(RIVAL_ONLY)
+    assert alone[1].reason == "rejected: ΔBIC +3.0"
+    # Beside a passing effect it stays in the round's head to head, which may name it.
+    beside = [_verdict("opaque_solar_gains", True), _verdict("wind_infiltration", True)]
+    _unrivalled(beside, {"opaque_solar_gains"})
+    assert all(f.accepted for f in beside)
+    # Without declared glazing it is no rival: it stands on its own margins.
+    own = [_verdict("opaque_solar_gains", True)]
+    _unrivalled(own, set())
+    assert own[0].accepted
 
 
 def test_the_opaque_sun_must_be_preferred_by_the_bic_over_the_glazing_held_to_glass(

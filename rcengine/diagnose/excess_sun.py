@@ -11,8 +11,11 @@ into the mass and the air together) uses the windows as a stand-in for sun that 
 another way. The description's glazing is taken as declared (``declared``), so that way is the
 opaque envelope.
 
-Where the building declares glazing, the opaque sun is therefore judged here, once the selection
-has ended, and not in its rounds: a model whose declared glazing still admits more sun than glass
+Where the building declares glazing, the opaque sun is therefore judged on its own here, once the
+selection has ended; in the rounds it stands only as a rival to an effect that passes, named when
+it explains the same mismatch better (a wind-driven leak can stand in for the sun a windy day's
+film strips from a dark facade, and a passing effect is no evidence that the facades are
+ordinary). Here, a model whose declared glazing still admits more sun than glass
 is refitted twice with the glazing held to glass (``held_to_glass``), as it is and with the
 opaque sun. The opaque sun is accepted when, with physical windows, it forecasts the test period
 at least as well as the model with impossible windows did, better than that model's own
@@ -52,9 +55,13 @@ if TYPE_CHECKING:
 
 EFFECT = "opaque_solar_gains"
 DECLARED_G = (G_WINDOW, G_WINDOW_AIR, G_WINDOW_ADDED_MASS)
-# Why the rounds leave the opaque sun out where glazing is declared (``state.skipped``).
-JUDGED_AFTER = (
-    "judged once the selection has ended, from sun the declared glazing admits beyond glass"
+# Why the rounds do not name the opaque sun on its own where glazing is declared: it stands there
+# only as a rival to an effect that passes (``selection._unrivalled``).
+RIVAL_ONLY = (
+    "where glazing is declared, the facades' sun is named in a round only when it explains the "
+    "mismatch better than another effect that passes (an ordinary envelope's sun cuts the test "
+    "error as much as a dark one's), and on its own once the selection has ended, from sun the "
+    "declared glazing admits beyond glass"
 )
 
 

@@ -9,7 +9,9 @@
    magnitudes are plausible for the building; with fold evidence (the default) it must also help
    in most rolling folds across the record and on their pooled test. Of those that pass, a head
    to head on the folds picks the one accepted (the runner-up is reported with why it lost);
-   repeat from the extended model until nothing more is accepted;
+   where glazing is declared the opaque sun takes part only as a rival, named when it beats an
+   effect that passes, never alone (``excess_sun``); repeat from the extended model until
+   nothing more is accepted;
 4. check every accepted finding backward: left out of the final model, does it still help across
    the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
@@ -40,7 +42,7 @@ from rcengine.diagnose.declared import (
     with_declared_glazing,
 )
 from rcengine.diagnose.excess_sun import EFFECT as EXCESS_SUN_EFFECT
-from rcengine.diagnose.excess_sun import JUDGED_AFTER, attribute_excess_sun
+from rcengine.diagnose.excess_sun import RIVAL_ONLY, attribute_excess_sun
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -120,7 +122,9 @@ class Selection:
     repair: dict | None = None
 
     def take(self, finding: Finding) -> None:
-        """Accept ``finding`` and continue from its model."""
+        """Accept ``finding`` and continue from its model (an earlier verdict on its effect goes:
+        it is accepted, not a verdict)."""
+        self.verdicts.pop(finding.effect, None)
         self.accepted.append(finding)
         self.current = finding.fit
         self.current_folds = None
@@ -417,9 +421,6 @@ def _extensions(problem: Problem, state: Selection) -> list[Extension]:
     taken = {f.effect for f in state.accepted}
     out = []
     for effect in (e for e in problem.settings.effects if e not in taken):
-        if effect == EXCESS_SUN_EFFECT and _judged_after(problem, state):
-            state.skipped[effect] = JUDGED_AFTER
-            continue
         built = CANDIDATES[effect](ctx)
         if isinstance(built, Skipped):
             state.skipped.setdefault(effect, built.reason)
@@ -429,10 +430,25 @@ def _extensions(problem: Problem, state: Selection) -> list[Extension]:
     return out
 
 
-def _judged_after(problem: Problem, state: Selection) -> bool:
-    """Whether the opaque sun waits for the step after the selection (``excess_sun``): where
-    glazing is declared, its evidence is the glazing's g-value, not a margin of test error."""
-    return problem.settings.excess_sun and has_glazing_g(state.current.network)
+def _rivals(problem: Problem, state: Selection) -> set[str]:
+    """The candidates a round may name only against another that passes: the opaque sun where
+    glazing is declared, whose evidence on its own is the glazing's g-value after the selection
+    (``excess_sun``), not a margin of test error."""
+    judged_after = problem.settings.excess_sun and has_glazing_g(state.current.network)
+    return {EXCESS_SUN_EFFECT} if judged_after else set()
+
+
+def _unrivalled(findings: list[Finding], rivals: set[str]) -> None:
+    """Where no finding but a rival passes, each passing rival is rejected with why."""
+    if any(f.accepted and f.effect not in rivals for f in findings):
+        return
+    for f in findings:
+        if f.accepted and f.effect in rivals:
+            f.accepted = False
+            f.reason = (
+                f"passed its own margins ({f.reason.removeprefix('accepted: ')}) but nothing else "
+                f"did: {RIVAL_ONLY}"
+            )
 
 
 def _context(problem: Problem, current: Fit) -> Context:
@@ -580,14 +596,17 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     confirmed = [
         _judge(problem, e, current, fit, screens[e.effect], round_no) for e, fit in versions
     ]
+    rivals = _rivals(problem, state)
+    _unrivalled(confirmed, rivals)
     if problem.folds:
         _confirm_on_folds(problem, state, [e for e, _ in versions], confirmed)
+        _unrivalled(confirmed, rivals)
     confirmed = _one_version_each(confirmed)
     for ext in ranked[n_refit:]:
         state.verdicts[ext.effect] = screened_only(ext, current, screens[ext.effect], round_no)
     for finding in confirmed:
         state.verdicts[finding.effect] = finding
-    return _winner(confirmed, state.verdicts, round_no)
+    return _winner(confirmed, round_no)
 
 
 def _confirm_on_folds(
@@ -781,13 +800,10 @@ def _without_each(
     return list(zip(fits, fold_fits, strict=True)), evidence
 
 
-def _winner(
-    confirmed: list[Finding], verdicts: dict[str, Finding], round_no: int
-) -> Finding | None:
+def _winner(confirmed: list[Finding], round_no: int) -> Finding | None:
     """Of the round's accepted findings, the one that wins every head to head (on the folds when
     they were judged on folds, ``folds.head_to_head``, else on the single split's test); the others
-    are marked not taken with why they lost, the closest as the winner's runner-up, and the
-    winner leaves ``verdicts`` (it is accepted, not a verdict)."""
+    are marked not taken with why they lost, the closest as the winner's runner-up."""
     winners = [f for f in confirmed if f.accepted]
     if not winners:
         return None
@@ -806,7 +822,6 @@ def _winner(
         f.reason = f"not taken in round {round_no}: lost to {best.effect} — {why}"
     if losers:
         best.runner_up = {"effect": losers[0].effect, "reason": losers[0].lost_to["reason"]}
-    del verdicts[best.effect]
     return best
 
 

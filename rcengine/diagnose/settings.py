@@ -53,8 +53,8 @@ class DiagnoseSettings:
     the vocabulary acts over hours (the sun's course, schedules, the mass's and an emitter's
     hours-long time constants), and a six-month record at a logger's 5 minutes took 74 s to
     judge against 18 s at 30 minutes; excess_sun: a model with declared glazing has the opaque
-    sun judged once the selection has ended, from sun the glazing admits beyond glass
-    (``excess_sun``), not in the selection's rounds."""
+    sun judged on its own once the selection has ended, from sun the glazing admits beyond glass
+    (``excess_sun``), and in the selection's rounds only as a rival to an effect that passes."""
 
     train_fraction: float = 0.5
     preset: str = "study"
