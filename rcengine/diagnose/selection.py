@@ -596,6 +596,8 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     confirmed = [
         _judge(problem, e, current, fit, screens[e.effect], round_no) for e, fit in versions
     ]
+    # A rival alone is rejected before the folds, so it costs no fold refits, and again after
+    # them, since the effect it stood beside may fail there.
     rivals = _rivals(problem, state)
     _unrivalled(confirmed, rivals)
     if problem.folds:
