@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
+
+import pandas as pd
 
 from rcengine.building import Building
 from rcengine.diagnose import DiagnoseSettings, diagnose
@@ -28,10 +31,12 @@ def diagnose_folder(
     figures: bool = True,
     settings: DiagnoseSettings | None = None,
     cloud_from: Path | None = None,
+    alter: Callable[[pd.DataFrame, Building], pd.DataFrame] | None = None,
 ) -> tuple[dict, float]:
     """Diagnose the case in ``folder`` with ``model``: its report as JSON data and the wall time
     of the diagnosis [s]. With ``out``, ``<case>.json`` (and its figures) are written there;
-    with ``cloud_from``, the weather file's cloud cover is added as the ``cloud_cover`` column."""
+    with ``cloud_from``, the weather file's cloud cover is added as the ``cloud_cover`` column;
+    ``alter`` changes the record first (a fault of real data, ``diagnose_faults``)."""
     name = folder.name
     building = Building.from_json(folder / "building.json")
     frame = read_timeseries(folder / "data.csv")
@@ -39,6 +44,8 @@ def diagnose_folder(
         from benchmarks.sky_temperature import weather_cloud_cover
 
         frame = frame.assign(cloud_cover=weather_cloud_cover(cloud_from, frame.index))
+    if alter is not None:
+        frame = alter(frame, building)
     started = time.perf_counter()
     report = diagnose(frame, building, model, settings)
     wall = time.perf_counter() - started

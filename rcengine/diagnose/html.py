@@ -214,6 +214,14 @@ def _day_ahead(d: dict) -> str:
     )
 
 
+def _clock(d: dict) -> str:
+    """A re-aligned record's note (``diagnose.clock``); nothing where the readings kept time."""
+    clock = d.get("clock")
+    if not clock or not clock["offset_h"]:
+        return ""
+    return f"<p class=no>Clock: {html.escape(clock['note'])}.</p>"
+
+
 def _no_folds(d: dict) -> str:
     if d["evidence"]["method"] == "split":
         return "<p>Judged on the single split alone (no folds asked for, or a short record).</p>"
@@ -263,7 +271,7 @@ def render(report: Report) -> str:
 test RMSE {d["baseline"]["rmse_test"]:.3f} K. Final <b>{esc(d["final"]["model"])}</b>:
 train {d["final"]["rmse_train"]:.3f} K, test {d["final"]["rmse_test"]:.3f} K.
 Training {esc(day(d["periods"]["train"][0]))} – {esc(day(d["periods"]["train"][1]))},
-test until {esc(day(d["periods"]["test"][1]))}.</p>{_day_ahead(d)}
+test until {esc(day(d["periods"]["test"][1]))}.</p>{_clock(d)}{_day_ahead(d)}
 <p>Where and when: {esc(d["mismatch"]["summary"])}.</p></div>
 <h2>Measured vs predicted</h2>{_png(timeseries_figure(report))}
 <h2>Where the errors concentrate</h2>{_png(heatmaps_figure(report))}

@@ -91,11 +91,16 @@ def worst_days(resid: np.ndarray, frame: pd.DataFrame, timezone: str, count: int
             "ghi": frame[GHI].to_numpy(),
         }
     )
-    daily = table.groupby("day").agg(
-        rmse=("r", lambda r: float(np.sqrt(np.nanmean(r**2)))),
-        mean=("r", "mean"),
-        t_out=("t_out", "mean"),
-        ghi=("ghi", "mean"),
+    # A day bridged whole (``bridge_short_gaps``) has no measured row to rank it by.
+    daily = (
+        table.dropna(subset=["r"])
+        .groupby("day")
+        .agg(
+            rmse=("r", lambda r: float(np.sqrt(np.mean(r**2)))),
+            mean=("r", "mean"),
+            t_out=("t_out", "mean"),
+            ghi=("ghi", "mean"),
+        )
     )
     daily = daily.dropna().sort_values("rmse", ascending=False).head(count)
     return [

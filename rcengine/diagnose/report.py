@@ -12,6 +12,7 @@ import pandas as pd
 from rcengine.building import Building
 from rcengine.columns import SOLAR_OPAQUE, SOLAR_WINDOW, solar_orientation_signal
 from rcengine.diagnose.candidates import Extension
+from rcengine.diagnose.clock import ClockCheck
 from rcengine.diagnose.fitting import Fit
 from rcengine.diagnose.folds import Fold, FoldEvidence, judge_folds
 from rcengine.diagnose.health import FitQuality, Health
@@ -358,10 +359,11 @@ def _face(finding: Finding, key: str, orientation: dict, peaks: dict[str, float]
 @dataclass
 class Report:
     """The diagnosis: ``health`` and ``quality`` of the base model as given, ``repair`` the
-    outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
-    extension had to help across (none: judged on the single split), ``folds_left_out`` those
-    whose training window barely ran the HVAC its test window ran; ``day_ahead`` the base and
-    final models' day-ahead forecasts over the test half (``diagnose.day_ahead``)."""
+        outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
+        extension had to help across (none: judged on the single split), ``folds_left_out`` those
+        whose training window barely ran the HVAC its test window ran; ``day_ahead`` the base and
+        final models' day-ahead forecasts over the test half (``diagnose.day_ahead``); ``clock`` how
+    the building's readings were aligned with the weather (``diagnose.clock``; None: unchecked)."""
 
     building: Building
     model: str
@@ -379,6 +381,7 @@ class Report:
     folds: list[Fold] = field(default_factory=list)
     folds_left_out: list[Fold] = field(default_factory=list)
     day_ahead: dict | None = None
+    clock: ClockCheck | None = None
 
     @property
     def accepted(self) -> list[Finding]:
@@ -431,6 +434,7 @@ class Report:
             "skipped": self.skipped,
             "whiteness": self.whiteness,
             "day_ahead": self.day_ahead,
+            "clock": None if self.clock is None else self.clock.to_dict(),
             "periods": {
                 "step_s": split.train.step_s,
                 "train": [split.train.times[0].isoformat(), self.boundary.isoformat()],

@@ -34,6 +34,7 @@ from rcengine.building import Building
 from rcengine.columns import Q_HVAC, T_IN
 from rcengine.dataset import aggregated, bridge_short_gaps
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, Skipped, mass_node
+from rcengine.diagnose.clock import check_clock, realigned
 from rcengine.diagnose.day_ahead import day_ahead_block
 from rcengine.diagnose.declared import (
     G_WINDOW_ADDED_MASS,
@@ -164,16 +165,18 @@ def _diagnose(
     started = time.perf_counter()
     frame = aggregated(bridge_short_gaps(frame), settings.min_step_s)
     timezone = building.location.timezone
-    boundary = split_time(frame, settings.train_fraction, timezone)
-    check_diagnosable(frame, boundary)
-    folds, left_out = [], []
-    if settings.evidence == "folds":
-        days = (settings.fold_train_days, settings.fold_test_days, settings.max_folds)
-        folds, left_out = _informative(frame, rolling_folds(frame.index, timezone, *days))
     say = progress or (lambda message: None)
-    problem = Problem(frame, building, boundary, settings, say, folds)
+    problem, left_out = _problem(frame, building, settings, say)
+    boundary = problem.boundary
     problem.say(f"fitting {model} on the training period (until {boundary.date()})")
     baseline = _baseline(problem, model)
+    clock = check_clock(problem, baseline) if settings.clock_check else None
+    if clock is not None and clock.offset_h:
+        problem.say(f"  {clock.words()}; fitting {model} again")
+        frame = realigned(frame, clock.offset_h, timezone)
+        problem, left_out = _problem(frame, building, settings, say)
+        boundary = problem.boundary
+        baseline = _baseline(problem, model)
     quality, health = _health(problem, baseline)
     locate = _locate(baseline, building)
     state = Selection(baseline)
@@ -208,10 +211,26 @@ def _diagnose(
         health,
         quality,
         state.repair,
-        folds,
+        problem.folds,
         left_out,
         day_ahead,
+        clock,
     )
+
+
+def _problem(
+    frame: pd.DataFrame, building: Building, settings: DiagnoseSettings, say: Callable[[str], None]
+) -> tuple[Problem, list[Fold]]:
+    """The record cut at its train/test boundary with its informative rolling folds, and the
+    folds left out."""
+    timezone = building.location.timezone
+    boundary = split_time(frame, settings.train_fraction, timezone)
+    check_diagnosable(frame, boundary)
+    folds, left_out = [], []
+    if settings.evidence == "folds":
+        days = (settings.fold_train_days, settings.fold_test_days, settings.max_folds)
+        folds, left_out = _informative(frame, rolling_folds(frame.index, timezone, *days))
+    return Problem(frame, building, boundary, settings, say, folds), left_out
 
 
 def _informative(frame: pd.DataFrame, folds: list[Fold]) -> tuple[list[Fold], list[Fold]]:

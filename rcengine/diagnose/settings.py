@@ -54,7 +54,9 @@ class DiagnoseSettings:
     hours-long time constants), and a six-month record at a logger's 5 minutes took 74 s to
     judge against 18 s at 30 minutes; excess_sun: a model with declared glazing has the opaque
     sun judged on its own once the selection has ended, from sun the glazing admits beyond glass
-    (``excess_sun``), and in the selection's rounds only as a rival to an effect that passes."""
+    (``excess_sun``), and in the selection's rounds only as a rival to an effect that passes;
+    clock_check: the building's summer-time readings are re-aligned by an hour where the base
+    model fits the weather clearly better so (a logger on standard time all year, ``clock``)."""
 
     train_fraction: float = 0.5
     preset: str = "study"
@@ -77,6 +79,7 @@ class DiagnoseSettings:
     min_fold_share: float = 0.5
     min_step_s: float = 900.0
     excess_sun: bool = True
+    clock_check: bool = True
 
     @property
     def fold_rule(self) -> FoldRule:
