@@ -34,6 +34,7 @@ import pandas as pd
 from rcengine.columns import Q_HVAC, Q_LIGHT, Q_OCC, T_IN
 from rcengine.diagnose.fitting import Fit, FitJob, fit_many
 from rcengine.diagnose.settings import FOLD_REFIT
+from rcengine.signals.schedules import clock_zone
 
 if TYPE_CHECKING:
     from rcengine.diagnose.selection import Problem
@@ -82,9 +83,11 @@ class ClockCheck:
 
 
 def summer_time(index: pd.DatetimeIndex, timezone: str) -> np.ndarray:
-    """Rows on daylight-saving time in ``timezone``."""
-    local = index.tz_convert(timezone)
-    return np.array([t.dst().total_seconds() > 0 for t in local], dtype=bool)
+    """Rows whose civil time in ``timezone`` is ahead of its standard time (the schedules'
+    "standard" clock, ``signals.schedules.clock_zone``)."""
+    civil = index.tz_convert(timezone).tz_localize(None)
+    standard = index.tz_convert(clock_zone(timezone, "standard")).tz_localize(None)
+    return np.asarray(civil != standard)
 
 
 def read_later(frame: pd.DataFrame, hours: float, rows: np.ndarray | None = None) -> pd.DataFrame:
@@ -111,14 +114,14 @@ def realigned(frame: pd.DataFrame, offset_h: float, timezone: str) -> pd.DataFra
 def check_clock(problem: Problem, baseline: Fit) -> ClockCheck:
     """The offset of the building's summer-time readings that the base model fits best, as
     stamped unless it cuts the training RMSE by more than ``CLOCK_MARGIN``."""
-    timezone = problem.building.location.timezone
-    train = problem.frame.index[problem.frame.index < problem.boundary]
-    summer = summer_time(train, timezone)
-    if summer.all() or not summer.any():
+    index = problem.frame.index
+    summer = summer_time(index, problem.building.location.timezone)
+    in_training = summer[index < problem.boundary]
+    if in_training.all() or not in_training.any():
         return ClockCheck(0.0, {0.0: baseline.rmse_train})
     jobs = []
     for hours in CLOCK_OFFSETS_H:
-        shifted = replace(problem, frame=realigned(problem.frame, hours, timezone))
+        shifted = replace(problem, frame=read_later(problem.frame, hours, summer))
         split = shifted.split(baseline.network, baseline.options)
         jobs.append(
             FitJob(

@@ -359,11 +359,12 @@ def _face(finding: Finding, key: str, orientation: dict, peaks: dict[str, float]
 @dataclass
 class Report:
     """The diagnosis: ``health`` and ``quality`` of the base model as given, ``repair`` the
-        outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
-        extension had to help across (none: judged on the single split), ``folds_left_out`` those
-        whose training window barely ran the HVAC its test window ran; ``day_ahead`` the base and
-        final models' day-ahead forecasts over the test half (``diagnose.day_ahead``); ``clock`` how
-    the building's readings were aligned with the weather (``diagnose.clock``; None: unchecked)."""
+    outcome of the structural step tried on an inadequate one; ``folds`` the rolling folds an
+    extension had to help across (none: judged on the single split), ``folds_left_out`` those
+    whose training window barely ran the HVAC its test window ran; ``day_ahead`` the base and
+    final models' day-ahead forecasts over the test half (``diagnose.day_ahead``); ``clock``
+    how the building's readings were aligned with the weather (``diagnose.clock``; None:
+    unchecked)."""
 
     building: Building
     model: str

@@ -167,15 +167,13 @@ def _diagnose(
     timezone = building.location.timezone
     say = progress or (lambda message: None)
     problem, left_out = _problem(frame, building, settings, say)
-    boundary = problem.boundary
-    problem.say(f"fitting {model} on the training period (until {boundary.date()})")
+    problem.say(f"fitting {model} on the training period (until {problem.boundary.date()})")
     baseline = _baseline(problem, model)
     clock = check_clock(problem, baseline) if settings.clock_check else None
     if clock is not None and clock.offset_h:
         problem.say(f"  {clock.words()}; fitting {model} again")
         frame = realigned(frame, clock.offset_h, timezone)
         problem, left_out = _problem(frame, building, settings, say)
-        boundary = problem.boundary
         baseline = _baseline(problem, model)
     quality, health = _health(problem, baseline)
     locate = _locate(baseline, building)
@@ -200,7 +198,7 @@ def _diagnose(
     return Report(
         building,
         model,
-        boundary,
+        problem.boundary,
         baseline,
         state.current,
         locate,
