@@ -156,7 +156,12 @@ def test_the_hidden_gain_is_confirmed_across_the_folds(gain_report):
     assert len(folds["folds"]) == 6 and folds["helped"] > 3
     assert folds["pooled_rmse_test_after"] <= 0.5 * folds["pooled_rmse_test_before"]
     assert "across folds: helps in" in first["reason"]
-    assert "across rolling folds: helps in" in render(gain_report)
+    assert {f["outcome"] for f in folds["folds"]} <= {"helped", "tied", "did not"}
+    assert folds["helped"] == sum(f["outcome"] == "helped" for f in folds["folds"])
+    assert folds["tied"] == sum(f["outcome"] == "tied" for f in folds["folds"])
+    page = render(gain_report)
+    assert "across rolling folds: helps in" in page
+    assert page.count("<td class=ok>helped</td>") >= folds["helped"]
 
 
 def test_a_baseline_no_better_than_a_constant_gives_the_inadequate_verdict(gain_report):

@@ -90,9 +90,37 @@ def test_accepts_only_what_helps_in_most_folds():
     assert ok and "helps in 6 of 6 folds" in why
 
 
+def test_a_fold_the_extension_barely_moves_is_a_tie_not_a_loss():
+    rule = FoldRule()
+    # Three folds helped a lot, two moved by under 2 % (one up, one down), one hurt: 3 of the 4
+    # folds that decide, where counting the ties as losses made it 3 of 6.
+    ev = _evidence([1.0, 1.0, 1.0, 1.0, 1.0, 1.0], [0.6, 0.6, 0.6, 1.01, 0.995, 1.1])
+    assert ev.tied.tolist() == [False, False, False, True, True, False]
+    assert ev.decided == 4 and int(ev.helped.sum()) == 3
+    ok, why = judge_folds(ev, rule)
+    assert ok and "helps in 3 of 4 folds (2 more tied)" in why
+    assert [f["outcome"] for f in ev.to_dict()["folds"]] == [
+        "helped",
+        "helped",
+        "helped",
+        "tied",
+        "tied",
+        "did not",
+    ]
+    # Just past the tie band either way the fold decides again.
+    ev = _evidence([1.0] * 6, [0.6, 0.6, 0.6, 1.03, 1.025, 1.1])
+    assert not judge_folds(ev, rule)[0]
+    # Every fold tied: no evidence that it helps.
+    ok, why = judge_folds(_evidence([1.0] * 6, [0.99] * 6), rule)
+    assert not ok and "helps in 0 of 0 folds (6 more tied)" in why
+
+
 def test_confidence_is_a_sign_test():
     assert _evidence([1.0] * 6, [0.5] * 6).confidence == pytest.approx(1 - 0.5**6)
     assert _evidence([1.0] * 6, [2.0] * 6).confidence == pytest.approx(0.0)
+    # Ties are dropped from the trials: 3 of 4 decided.
+    tied = _evidence([1.0] * 6, [0.5, 0.5, 0.5, 0.99, 1.01, 2.0])
+    assert tied.confidence == pytest.approx(1 - (1 + 4) / 16)
 
 
 def test_head_to_head_names_the_winner_and_the_margin():

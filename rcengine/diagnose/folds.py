@@ -87,6 +87,15 @@ def _local_midnight(first: pd.Timestamp, days: int) -> pd.Timestamp:
     )
 
 
+# A fold whose test RMSE an extension moves by less than this share either way is a tie: no
+# evidence for or against it, dropped from the count as a sign test drops ties (Dixon & Mood
+# 1946). The folds' refits reproduce within it: the same model refitted on 29 folds of five
+# dev-pool cases from two other seeds moved 27 of them by under 0.1 %, one by 1.6 %, one by
+# 6.4 %. Counted as losses, such folds had rejected two concealed sky losses (3 of 6 folds
+# helped, the others +0.3 %, +0.7 %, +1.2 % and more; −16 % and −40 % pooled). [-]
+FOLD_TIE_SHARE = 0.02
+
+
 @dataclass(frozen=True)
 class FoldEvidence:
     """Test errors of the current model (``before``) and of an extension (``after``) on every
@@ -113,21 +122,33 @@ class FoldEvidence:
         return _rmse(np.concatenate(self.after))
 
     @property
+    def tied(self) -> np.ndarray:
+        """Per fold: did the extension move the test RMSE by less than ``FOLD_TIE_SHARE``?"""
+        before = self.rmse_before
+        return np.abs(self.rmse_after - before) < FOLD_TIE_SHARE * before
+
+    @property
     def helped(self) -> np.ndarray:
-        """Per fold: did the extension lower the test RMSE?"""
-        return self.rmse_after < self.rmse_before
+        """Per fold: did the extension lower the test RMSE, by more than a tie?"""
+        return (self.rmse_after < self.rmse_before) & ~self.tied
+
+    @property
+    def decided(self) -> int:
+        """The folds that are not ties: the sign test's trials."""
+        return int((~self.tied).sum())
 
     @property
     def confidence(self) -> float:
-        """1 − the one-sided sign-test p-value of "helps in this many folds" under "helps or
-        hurts at random" (each fold a fair coin): how unlikely that record is by chance."""
-        n, k = len(self.before), int(self.helped.sum())
+        """1 − the one-sided sign-test p-value of "helps in this many of the untied folds" under
+        "helps or hurts at random" (each a fair coin): how unlikely that record is by chance."""
+        n, k = self.decided, int(self.helped.sum())
         return float(1.0 - binom.sf(k - 1, n, 0.5)) if n else 0.0
 
     def to_dict(self, folds: list[Fold] | None = None, timezone: str = "UTC") -> dict:
+        outcome = np.where(self.helped, "helped", np.where(self.tied, "tied", "did not"))
         per_fold = [
-            {"rmse_test_before": float(b), "rmse_test_after": float(a)}
-            for b, a in zip(self.rmse_before, self.rmse_after, strict=True)
+            {"rmse_test_before": float(b), "rmse_test_after": float(a), "outcome": str(o)}
+            for b, a, o in zip(self.rmse_before, self.rmse_after, outcome, strict=True)
         ]
         if folds is not None:
             for row, fold in zip(per_fold, folds, strict=True):
@@ -135,6 +156,7 @@ class FoldEvidence:
         return {
             "folds": per_fold,
             "helped": int(self.helped.sum()),
+            "tied": int(self.tied.sum()),
             "pooled_rmse_test_before": self.pooled_before,
             "pooled_rmse_test_after": self.pooled_after,
             "confidence": self.confidence,
@@ -162,13 +184,16 @@ class FoldRule:
 
 
 def judge_folds(evidence: FoldEvidence, rule: FoldRule) -> tuple[bool, str]:
-    """Accept when the extension helps in more than ``min_share`` of the folds and cuts the
-    pooled test RMSE by the rule's relative margin; the text says which check decided."""
-    n, k = len(evidence.before), int(evidence.helped.sum())
+    """Accept when the extension helps in more than ``min_share`` of the folds it does not tie
+    (``FoldEvidence.tied``) and cuts the pooled test RMSE by the rule's relative margin; the
+    text says which check decided."""
+    n, k = evidence.decided, int(evidence.helped.sum())
+    ties = len(evidence.before) - n
     before, after = evidence.pooled_before, evidence.pooled_after
     gain = before - after
+    tied = f" ({ties} more tied)" if ties else ""
     checks = [
-        (n > 0 and k > rule.min_share * n, f"helps in {k} of {n} folds"),
+        (n > 0 and k > rule.min_share * n, f"helps in {k} of {n} folds{tied}"),
         (
             gain >= rule.min_improvement * before,
             f"pooled test RMSE {before:.3f} → {after:.3f} K ({-gain / before:+.0%})",

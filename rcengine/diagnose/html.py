@@ -177,6 +177,14 @@ def _fold_tables(finding: dict) -> str:
     )
 
 
+def _outcome_cell(fold: dict) -> str:
+    """A fold's verdict on an extension (``FoldEvidence.to_dict``; a report written before ties
+    were told apart has none, and each fold there helped or did not)."""
+    helped = fold["rmse_test_after"] < fold["rmse_test_before"]
+    outcome = fold.get("outcome", "helped" if helped else "did not")
+    return f"<td class={'ok' if outcome == 'helped' else 'no'}>{outcome}</td>"
+
+
 def _folds_table(title: str, folds: dict | None) -> str:
     """Per-fold test RMSE before and after an extension, and the pooled test."""
     if not folds:
@@ -184,17 +192,15 @@ def _folds_table(title: str, folds: dict | None) -> str:
     rows = "".join(
         f"<tr><td>{html.escape(f.get('test', str(k + 1)))}</td>"
         f"<td>{f['rmse_test_before']:.3f}</td><td>{f['rmse_test_after']:.3f}</td>"
-        + (
-            "<td class=ok>helped</td>"
-            if f["rmse_test_after"] < f["rmse_test_before"]
-            else "<td class=no>did not</td>"
-        )
+        + _outcome_cell(f)
         + "</tr>"
         for k, f in enumerate(folds["folds"])
     )
+    ties = folds.get("tied", 0)
+    tied = f", {ties} tied" if ties else ""
     return (
         f"<h4>{html.escape(title)}: helps in {folds['helped']} "
-        f"of {len(folds['folds'])} (confidence {folds['confidence']:.0%})</h4>"
+        f"of {len(folds['folds'])}{tied} (confidence {folds['confidence']:.0%})</h4>"
         "<table><tr><th>test period</th><th>RMSE before [K]</th><th>after [K]</th><th></th></tr>"
         f"{rows}<tr><td><b>pooled</b></td><td>{folds['pooled_rmse_test_before']:.3f}</td>"
         f"<td>{folds['pooled_rmse_test_after']:.3f}</td><td></td></tr></table>"

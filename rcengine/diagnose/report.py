@@ -287,9 +287,10 @@ def explain(finding: Finding, pattern: str) -> str:
 def _across(finding: Finding) -> str:
     if finding.folds is None:
         return ""
-    n = len(finding.folds["folds"])
+    n, ties = len(finding.folds["folds"]), finding.folds.get("tied", 0)
+    tied = f", {ties} tied" if ties else ""
     return (
-        f"; across {n} rolling folds it helps in {finding.folds['helped']} "
+        f"; across {n} rolling folds it helps in {finding.folds['helped']}{tied} "
         f"(pooled test RMSE {finding.folds['pooled_rmse_test_before']:.2f} → "
         f"{finding.folds['pooled_rmse_test_after']:.2f} K)"
     )
