@@ -177,14 +177,6 @@ def _fold_tables(finding: dict) -> str:
     )
 
 
-def _outcome_cell(fold: dict) -> str:
-    """A fold's verdict on an extension (``FoldEvidence.to_dict``; a report written before ties
-    were told apart has none, and each fold there helped or did not)."""
-    helped = fold["rmse_test_after"] < fold["rmse_test_before"]
-    outcome = fold.get("outcome", "helped" if helped else "did not")
-    return f"<td class={'ok' if outcome == 'helped' else 'no'}>{outcome}</td>"
-
-
 def _folds_table(title: str, folds: dict | None) -> str:
     """Per-fold test RMSE before and after an extension, and the pooled test."""
     if not folds:
@@ -192,12 +184,10 @@ def _folds_table(title: str, folds: dict | None) -> str:
     rows = "".join(
         f"<tr><td>{html.escape(f.get('test', str(k + 1)))}</td>"
         f"<td>{f['rmse_test_before']:.3f}</td><td>{f['rmse_test_after']:.3f}</td>"
-        + _outcome_cell(f)
-        + "</tr>"
+        f"<td class={'ok' if f['outcome'] == 'helped' else 'no'}>{f['outcome']}</td></tr>"
         for k, f in enumerate(folds["folds"])
     )
-    ties = folds.get("tied", 0)
-    tied = f", {ties} tied" if ties else ""
+    tied = f", {folds['tied']} tied" if folds["tied"] else ""
     return (
         f"<h4>{html.escape(title)}: helps in {folds['helped']} "
         f"of {len(folds['folds'])}{tied} (confidence {folds['confidence']:.0%})</h4>"

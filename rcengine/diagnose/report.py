@@ -287,7 +287,7 @@ def explain(finding: Finding, pattern: str) -> str:
 def _across(finding: Finding) -> str:
     if finding.folds is None:
         return ""
-    n, ties = len(finding.folds["folds"]), finding.folds.get("tied", 0)
+    n, ties = len(finding.folds["folds"]), finding.folds["tied"]
     tied = f", {ties} tied" if ties else ""
     return (
         f"; across {n} rolling folds it helps in {finding.folds['helped']}{tied} "
