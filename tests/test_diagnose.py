@@ -125,6 +125,30 @@ def test_a_day_seen_once_is_an_episode_not_a_schedule():
     assert schedule.startswith("Mon–Fri 07:00–") and "Sat" not in schedule, schedule
 
 
+def test_unmetered_gains_in_step_with_the_metered_use():
+    """Equipment switched on with the people and lights: 40 % of q_occ + q_light more, into the
+    air. The candidate's alternative that follows the metered use reproduces the record at
+    q_unmetered = 0.4 × the metered gains' mean over the occupied hours, per m² of floor."""
+    inputs = weather_and_gains(14)
+    metered = inputs["q_occ"] + inputs["q_light"]
+    truth_inputs = inputs.assign(q_occ=inputs["q_occ"] + 0.4 * metered)
+    frame = inputs.assign(t_in=basic_reference(truth_inputs, TRUTH_BASIC, (15.0, 19.0, 19.0)))
+    network = get_model("basic", BUILDING, frame.columns)
+    data = split_data(frame, BUILDING, network, SignalOptions(), frame.index[-1]).train
+    residual = residual_at(network, TRUTH_BASIC, data)
+    ctx = Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, residual)
+    found = CANDIDATES["unmetered_gains"](ctx)
+    use = next(e for e in (found, *found.alternatives) if "follows" in e.detail)
+    occupied = inputs["q_occ"].loc[data.times] > 0
+    mean_w_m2 = metered.loc[data.times][occupied].mean() / BUILDING.floor_area
+    assert use.detail["metered_w_m2"] == pytest.approx(mean_w_m2)
+    assert use.detail["occupied_share"] == 1.0
+    params = {**TRUTH_BASIC, "q_unmetered": 0.4 * mean_w_m2}
+    # (to the first hours' unmeasured wall and mass temperatures, which the reference starts apart)
+    assert np.abs(residual_at(use.network, params, data)).max() < 1e-3
+    assert np.abs(residual).max() > 0.5  # without it the record is not explained
+
+
 def test_on_off_explainer_equals_the_bounded_least_squares_it_shortcuts():
     rng = np.random.default_rng(1)
     responses, nuisance = rng.normal(size=(400, 6)), rng.normal(size=(400, 3))

@@ -176,6 +176,19 @@ def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
     assert _one_version_each([first, refined]) == [refined]
 
 
+def test_the_folds_choose_between_a_learnt_schedule_and_the_metered_use():
+    """An unmetered gain on a learnt schedule and one in step with the metered use are two
+    versions of one effect: the one the folds favour is kept, the other named."""
+    learnt = _version("unmetered_gains", "Mon–Fri 15:00–19:00", 1.0, 0.8)
+    use = _version("unmetered_gains", "", 2.0, 0.6)
+    use.detail = {"follows": "q_occ + q_light"}
+    assert _one_version_each([learnt, use]) == [use]
+    assert use.detail["schedule_not_taken"] == "Mon–Fri 15:00–19:00 (0.800 K)"
+    learnt, use = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 1.0, 0.5), use
+    assert _one_version_each([learnt, use]) == [learnt]
+    assert learnt.detail["use_not_taken"] == "0.600 K pooled over the folds"
+
+
 def _accepted(effect: str, round_no: int, repair: bool = False, folds: bool = True) -> Finding:
     """An accepted finding, on the folds' evidence unless ``folds`` is False (the opaque sun
     judged from the glazing's magnitude after the selection)."""

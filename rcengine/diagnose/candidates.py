@@ -581,25 +581,32 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     return _on_schedule(ext, VENT_SCHEDULE, learnt)
 
 
-def unmetered_gains(ctx: Context) -> Extension | Skipped:
-    """Internal gains missing from the data, on the weekly schedule the residuals reveal."""
-    effect = "unmetered_gains"
-    if SCHED_GAINS in ctx.network.signals:
-        return Skipped(effect, "the model already has an unmetered-gain schedule")
-    # A missing gain would lighten the heater's load; a heater at capacity is evidence of the
-    # opposite, and its recovery (metered) must not be learnt as a gain.
-    saturated = heater_saturated(ctx.train)
-    learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)), saturated)
-    if not learnt.schedule.any():
-        return Skipped(effect, "the residuals show no weekly pattern of missing heat")
-    floor = ctx.building.floor_area
-    q_unmetered = Parameter(
+def _q_unmetered(hours: str) -> Parameter:
+    return Parameter(
         "q_unmetered",
         "W/m²",
         0.0,
         SEARCH_MARGIN * UNMETERED_W_M2[1],
-        "unmetered internal heat (equipment, people) in the scheduled hours, per m² of floor",
+        f"unmetered internal heat (equipment, people) in the {hours} hours, per m² of floor",
     )
+
+
+def unmetered_gains(ctx: Context) -> Extension | Skipped:
+    """Internal gains missing from the data, on the weekly schedule the residuals reveal, and,
+    as its alternative, in step with the metered use of the building (``_gains_with_use``)."""
+    effect = "unmetered_gains"
+    if SCHED_GAINS in ctx.network.signals or _has_gains_with_use(ctx.network):
+        return Skipped(effect, "the model already has unmetered gains")
+    # A missing gain would lighten the heater's load; a heater at capacity is evidence of the
+    # opposite, and its recovery (metered) must not be learnt as a gain.
+    saturated = heater_saturated(ctx.train)
+    learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)), saturated)
+    with_use = _gains_with_use(ctx)
+    if not learnt.schedule.any():
+        if with_use is None:
+            return Skipped(effect, "the residuals show no weekly pattern of missing heat")
+        return with_use
+    floor = ctx.building.floor_area
     heat = (SCHED_GAINS, ctx.network.output)
     on = _on_learnt_hours(ctx, learnt)
     detail = {
@@ -607,8 +614,52 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
         **occupied_shares(ctx, on),
         **metered_gains_on_schedule(ctx, on),
     }
-    ext = _with_gain(ctx, effect, q_unmetered, heat, detail, floor)
-    return _on_schedule(ext, GAINS_SCHEDULE, learnt)
+    ext = _with_gain(ctx, effect, _q_unmetered("scheduled"), heat, detail, floor)
+    ext = _on_schedule(ext, GAINS_SCHEDULE, learnt)
+    return ext if with_use is None else replace(ext, alternatives=(with_use,))
+
+
+def _has_gains_with_use(net: RCNetwork) -> bool:
+    return any(h.gain == "q_unmetered" for h in net.heat_inputs)
+
+
+def _gains_with_use(ctx: Context) -> Extension | None:
+    """Unmetered gains that follow the building's metered use (equipment switched on with the
+    people and lights, the usual plug loads): q(t) = q_unmetered·A_floor·m(t)/m̄ into the air,
+    m = q_occ + q_light [W] and m̄ its mean over the training rows with occupants metered
+    (q_occ > 0), so that q_unmetered is the gain's mean over the occupied hours [W/m²]. A
+    schedule learnt from the residuals can take the hours the base model errs in rather than
+    the gain's (a heavy building's residual holds little of a daytime gain's shape); the metered
+    use gives the shape without learning it. None without occupants metered."""
+    if Q_OCC not in ctx.train.columns:
+        return None
+    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
+    metered = sum(np.nan_to_num(ctx.train[c].to_numpy(dtype=float)) for c in columns)
+    occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
+    if not occupied.any() or float(np.mean(metered[occupied])) <= 0.0:
+        return None
+    floor = ctx.building.floor_area
+    net = ctx.network.copy(_name(ctx.network, "unmetered_gains"))
+    gain = _q_unmetered("occupied")
+    net.add_parameter(gain)
+    per_watt = floor / float(np.mean(metered[occupied]))
+    for column in columns:
+        net.add_heat_input(column, net.output, gain.name, factor=per_watt)
+    detail = {
+        "floor_area_m2": floor,
+        "follows": " + ".join(columns),
+        **occupied_shares(ctx, occupied),
+        **metered_gains_on_schedule(ctx, occupied),
+    }
+    return Extension(
+        "unmetered_gains",
+        net,
+        ctx.signals,
+        (gain.name,),
+        tuple((c, net.output) for c in columns),
+        neutral={gain.name: 0.0},
+        detail=detail,
+    )
 
 
 def _on_learnt_hours(ctx: Context, learnt: LearntSchedule) -> np.ndarray:

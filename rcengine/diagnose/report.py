@@ -336,6 +336,8 @@ def _facts(finding: Finding) -> str:
         return f" ({faces})"
     if "schedule" in d:
         return f" (schedule learnt from the residuals: {d['schedule']})"
+    if "follows" in d:
+        return f" (in step with the metered use, {d['follows']})"
     if "glazing_g_on_storage" in d:
         return f" (the declared glazing's sun falls on it too: g = {d['glazing_g_on_storage']:.2f})"
     return ""

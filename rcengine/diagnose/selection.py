@@ -569,6 +569,8 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
         if worse.evidence is not None and "schedule" in worse.detail:
             pooled = worse.evidence.pooled_after
             best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+        if "follows" in worse.detail:
+            best.detail["use_not_taken"] = _version_words(worse)
         if "ground_lag_months" in worse.detail:
             lag, how = worse.detail["ground_lag_months"], _version_words(worse)
             best.detail["ground_lag_not_taken"] = f"{lag:.1f} months ({how})"
