@@ -506,11 +506,14 @@ def sealed_cases(seed: int = SEALED_SEED) -> tuple[Case, ...]:
 #   open-plan San Francisco unmetered-gain case and heavy San Francisco unmetered-gain + opaque
 #   pair by 0.04 and 0.91 kWh/m², + 73 its open-plan San Francisco unmetered-gain case by 0.11;
 # - + 75 put the wind of a light Torino wind + sky pair at 0.21 K rms; + 77 the window of a light
-#   Golden ventilation + window pair at 0.298 K rms.
+#   Golden ventilation + window pair at 0.298 K rms;
+# - + 79 heated its open-plan San Francisco unmetered-gain case by 0.13 kWh/m², + 80 its heavy
+#   San Francisco window case by 0.07 kWh/m² (and put the window of a window + wind pair at
+#   0.24 K rms).
 # The ninth (+ 16) was committed as drawn: its heavy San Francisco null heats 19 kWh all season
 # and its heavy San Francisco ground + window pair 98 kWh, each still heated at some time, the
 # rule every set was drawn under.
-# Each up to the twenty-fifth has been diagnosed once (the twenty-sixth, + 78, is drawn and
+# Each up to the twenty-sixth has been diagnosed once (the twenty-seventh, + 81, is drawn and
 # committed, not diagnosed); the thirteenth (+ 28) passed both floors at the first seed tried.
 # From the eleventh set on a draw must also heat every case by at least
 # ``MIN_HEATING_KWH_M2`` over the season (checked in tests/test_testbed.py): an office that
@@ -545,6 +548,7 @@ SEALED_SEEDS: dict[str, int] = {
     "testbed_sealed_24": SEALED_SEED + 74,
     "testbed_sealed_25": SEALED_SEED + 76,
     "testbed_sealed_26": SEALED_SEED + 78,
+    "testbed_sealed_27": SEALED_SEED + 81,
 }
 SEALED_SETS: dict[str, tuple[Case, ...]] = {
     name: sealed_cases(seed) for name, seed in SEALED_SEEDS.items()
