@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rcengine.diagnose import DiagnoseSettings, diagnose, split_time
+from rcengine.diagnose import DiagnoseSettings, diagnose, selection, split_time
 from rcengine.diagnose.candidates import CANDIDATES, Context, Skipped
 from rcengine.diagnose.fitting import residual_at, split_data
 from rcengine.diagnose.html import render
@@ -211,6 +211,33 @@ def test_hidden_weekly_gain_is_found_named_and_fixed(hidden_gain_record):
     html = render(report)
     assert "unmetered_gains" in html and "<img" in html
     assert "as the service forecasts for an MPC" in html
+
+
+@pytest.mark.parametrize("evidence", ["split", "folds"])
+def test_only_the_folds_choose_the_gain_in_step_with_the_use(
+    hidden_gain_record, monkeypatch, evidence
+):
+    """The unmetered gain in step with the metered use is a version only the folds choose
+    (``folds_only``): a diagnosis on a single split never refits it; one on folds does."""
+    refitted = []
+    fit_from_current = selection._fit_from_current
+
+    def spy(problem, current, extensions, splits):
+        refitted.extend(extensions)
+        return fit_from_current(problem, current, extensions, splits)
+
+    monkeypatch.setattr(selection, "_fit_from_current", spy)
+    settings = DiagnoseSettings(
+        train_fraction=0.6,
+        evidence=evidence,
+        baseline_starts=1,
+        max_rounds=1,
+        effects=("unmetered_gains",),
+        fold_train_days=6,
+        fold_test_days=3,
+    )
+    diagnose(hidden_gain_record, BUILDING, "basic", settings)
+    assert any(e.folds_only for e in refitted) == (evidence == "folds")
 
 
 def test_a_five_minute_record_is_judged_at_a_quarter_hour(hidden_gain_record):

@@ -130,6 +130,9 @@ class Extension:
     # Other versions of the same physics with the same parameters (the soil read at another lag),
     # each refitted beside it and judged as a version of one effect (``selection._versions``).
     alternatives: tuple[Extension, ...] = ()
+    # An alternative only the folds can choose (a shape that may fit one split and forecast
+    # worse): left out of a diagnosis judged on a single split.
+    folds_only: bool = False
 
 
 @dataclass(frozen=True)
@@ -630,7 +633,12 @@ def _gains_with_use(ctx: Context) -> Extension | None:
     (q_occ > 0), so that q_unmetered is the gain's mean over the occupied hours [W/m²]. A
     schedule learnt from the residuals can take the hours the base model errs in rather than
     the gain's (a heavy building's residual holds little of a daytime gain's shape); the metered
-    use gives the shape without learning it. None without occupants metered."""
+    use gives the shape without learning it. None without occupants metered.
+
+    Only the folds choose it over the learnt schedule (``folds_only``): on a single split the
+    unmetered variant's record before February took it by both the split's test and the
+    training fit, and its adopted model served the first week of February a day-ahead forecast
+    0.395 K off, against 0.342 K with the learnt schedule."""
     if Q_OCC not in ctx.train.columns:
         return None
     columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
@@ -659,6 +667,7 @@ def _gains_with_use(ctx: Context) -> Extension | None:
         tuple((c, net.output) for c in columns),
         neutral={gain.name: 0.0},
         detail=detail,
+        folds_only=True,
     )
 
 

@@ -534,8 +534,13 @@ def _alternatives(
     """Each extension's alternatives (``Extension.alternatives``: the same parameters, another
     reading of its input), refitted from the same starts as the first version (``_refits``), so
     that each version is the fit it would be alone; as (index of the first version, alternative,
-    fit)."""
-    where = [(i, alt) for i, ext in enumerate(extensions) for alt in ext.alternatives]
+    fit). A ``folds_only`` alternative only where the folds judge."""
+    where = [
+        (i, alt)
+        for i, ext in enumerate(extensions)
+        for alt in ext.alternatives
+        if problem.folds or not alt.folds_only
+    ]
     alternatives = [alt for _, alt in where]
     splits = [problem.split(alt.network, alt.signals) for alt in alternatives]
     refits = _fit_from_current(problem, current, alternatives, splits) if where else []
