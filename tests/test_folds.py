@@ -184,9 +184,9 @@ def test_the_folds_choose_between_a_learnt_schedule_and_the_metered_use():
     use.detail = {"follows": "q_occ + q_light"}
     assert _one_version_each([learnt, use]) == [use]
     assert use.detail["schedule_not_taken"] == "Mon–Fri 15:00–19:00 (0.800 K)"
-    learnt, use = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 1.0, 0.5), use
-    assert _one_version_each([learnt, use]) == [learnt]
-    assert learnt.detail["use_not_taken"] == "0.600 K pooled over the folds"
+    better_learnt = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 1.0, 0.5)
+    assert _one_version_each([better_learnt, use]) == [better_learnt]
+    assert better_learnt.detail["use_not_taken"] == "0.600 K pooled over the folds"
 
 
 def _accepted(effect: str, round_no: int, repair: bool = False, folds: bool = True) -> Finding:

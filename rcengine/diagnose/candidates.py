@@ -596,9 +596,10 @@ def _q_unmetered(hours: str) -> Parameter:
 
 def unmetered_gains(ctx: Context) -> Extension | Skipped:
     """Internal gains missing from the data, on the weekly schedule the residuals reveal, and,
-    as its alternative, in step with the metered use of the building (``_gains_with_use``)."""
+    as its alternative, in step with the metered use of the building (``_gains_with_use``;
+    where the residuals show no schedule, that version alone)."""
     effect = "unmetered_gains"
-    if SCHED_GAINS in ctx.network.signals or _has_gains_with_use(ctx.network):
+    if any(h.gain == "q_unmetered" for h in ctx.network.heat_inputs):
         return Skipped(effect, "the model already has unmetered gains")
     # A missing gain would lighten the heater's load; a heater at capacity is evidence of the
     # opposite, and its recovery (metered) must not be learnt as a gain.
@@ -620,10 +621,6 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     ext = _with_gain(ctx, effect, _q_unmetered("scheduled"), heat, detail, floor)
     ext = _on_schedule(ext, GAINS_SCHEDULE, learnt)
     return ext if with_use is None else replace(ext, alternatives=(with_use,))
-
-
-def _has_gains_with_use(net: RCNetwork) -> bool:
-    return any(h.gain == "q_unmetered" for h in net.heat_inputs)
 
 
 def _gains_with_use(ctx: Context) -> Extension | None:
