@@ -607,9 +607,8 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)), saturated)
     with_use = _gains_with_use(ctx)
     if not learnt.schedule.any():
-        if with_use is None:
-            return Skipped(effect, "the residuals show no weekly pattern of missing heat")
-        return with_use
+        no_pattern = Skipped(effect, "the residuals show no weekly pattern of missing heat")
+        return no_pattern if with_use is None else with_use
     floor = ctx.building.floor_area
     heat = (SCHED_GAINS, ctx.network.output)
     on = _on_learnt_hours(ctx, learnt)
@@ -638,23 +637,21 @@ def _gains_with_use(ctx: Context) -> Extension | None:
     0.395 K off, against 0.342 K with the learnt schedule."""
     if Q_OCC not in ctx.train.columns:
         return None
-    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
-    metered = sum(np.nan_to_num(ctx.train[c].to_numpy(dtype=float)) for c in columns)
     occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
-    if not occupied.any() or float(np.mean(metered[occupied])) <= 0.0:
+    metered = metered_gains_on_schedule(ctx, occupied)  # m̄ / A_floor, where m̄ > 0
+    if not metered:
         return None
-    floor = ctx.building.floor_area
+    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
     net = ctx.network.copy(_name(ctx.network, "unmetered_gains"))
     gain = _q_unmetered("occupied")
     net.add_parameter(gain)
-    per_watt = floor / float(np.mean(metered[occupied]))
     for column in columns:
-        net.add_heat_input(column, net.output, gain.name, factor=per_watt)
+        net.add_heat_input(column, net.output, gain.name, factor=1.0 / metered["metered_w_m2"])
     detail = {
-        "floor_area_m2": floor,
+        "floor_area_m2": ctx.building.floor_area,
         "follows": " + ".join(columns),
         **occupied_shares(ctx, occupied),
-        **metered_gains_on_schedule(ctx, occupied),
+        **metered,
     }
     return Extension(
         "unmetered_gains",
