@@ -584,9 +584,13 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
     return _on_schedule(ext, VENT_SCHEDULE, learnt)
 
 
+# The unmetered gain's parameter, in either version (learnt schedule, metered use).
+Q_UNMETERED = "q_unmetered"
+
+
 def _q_unmetered(hours: str) -> Parameter:
     return Parameter(
-        "q_unmetered",
+        Q_UNMETERED,
         "W/m²",
         0.0,
         SEARCH_MARGIN * UNMETERED_W_M2[1],
@@ -599,7 +603,7 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     as its alternative, in step with the metered use of the building (``_gains_with_use``;
     where the residuals show no schedule, that version alone)."""
     effect = "unmetered_gains"
-    if any(h.gain == "q_unmetered" for h in ctx.network.heat_inputs):
+    if any(h.gain == Q_UNMETERED for h in ctx.network.heat_inputs):
         return Skipped(effect, "the model already has unmetered gains")
     # A missing gain would lighten the heater's load; a heater at capacity is evidence of the
     # opposite, and its recovery (metered) must not be learnt as a gain.
@@ -635,13 +639,13 @@ def _gains_with_use(ctx: Context) -> Extension | None:
     unmetered variant's record before February took it by both the split's test and the
     training fit, and its adopted model served the first week of February a day-ahead forecast
     0.395 K off, against 0.342 K with the learnt schedule."""
-    if Q_OCC not in ctx.train.columns:
+    occupied = _occupied(ctx)
+    if occupied is None:
         return None
-    occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
     metered = metered_gains_on_schedule(ctx, occupied)  # m̄ / A_floor, where m̄ > 0
     if not metered:
         return None
-    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
+    columns = _metered_columns(ctx)
     net = ctx.network.copy(_name(ctx.network, "unmetered_gains"))
     gain = _q_unmetered("occupied")
     net.add_parameter(gain)
@@ -672,14 +676,25 @@ def _on_learnt_hours(ctx: Context, learnt: LearntSchedule) -> np.ndarray:
     return learnt.schedule[hour_of_week(ctx.data.times, zone, closed)] > 0.0
 
 
+def _occupied(ctx: Context) -> np.ndarray | None:
+    """The training rows in which occupants are metered (``q_occ`` > 0); None without a
+    ``q_occ`` column."""
+    if Q_OCC not in ctx.train.columns:
+        return None
+    return np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
+
+
+def _metered_columns(ctx: Context) -> list[str]:
+    """The metered internal gains the record has: ``q_occ`` and ``q_light``, where given."""
+    return [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
+
+
 def occupied_shares(ctx: Context, on: np.ndarray) -> dict[str, float]:
     """Shares of the training rows in which occupants are metered (``q_occ`` > 0): of those a
     learnt schedule is ``on`` (``occupied_share``) and of all (``occupied_share_all``) [-]; empty
     without a ``q_occ`` column, or when it meters no occupant."""
-    if Q_OCC not in ctx.train.columns:
-        return {}
-    occupied = np.nan_to_num(ctx.train[Q_OCC].to_numpy(dtype=float)) > 0.0
-    if not occupied.any() or not on.any():
+    occupied = _occupied(ctx)
+    if occupied is None or not occupied.any() or not on.any():
         return {}
     share, share_all = float(occupied[on].mean()), float(occupied.mean())
     return {"occupied_share": share, "occupied_share_all": share_all}
@@ -689,7 +704,7 @@ def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
     """The metered internal gains (``q_occ`` + ``q_light``) per m² of floor, averaged over the
     training rows a learnt schedule is ``on`` (``metered_w_m2``) [W/m²]; empty without either
     column or when they meter nothing there."""
-    columns = [c for c in (Q_OCC, Q_LIGHT) if c in ctx.train.columns]
+    columns = _metered_columns(ctx)
     if not columns or not on.any():
         return {}
     metered = sum(np.nan_to_num(ctx.train[c].to_numpy(dtype=float)) for c in columns)
