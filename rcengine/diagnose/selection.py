@@ -449,8 +449,8 @@ def _extensions(problem: Problem, state: Selection) -> list[Extension]:
 
 def _rivals(problem: Problem, state: Selection) -> set[str]:
     """The candidates a round may name only against another that passes: the opaque sun where
-    glazing is declared, whose evidence on its own is the glazing's g-value after the selection
-    (``excess_sun``), not a margin of test error."""
+    glazing is declared, whose evidence on its own is the model's sun beyond glass after the
+    selection (``excess_sun``), not a margin of test error."""
     judged_after = problem.settings.excess_sun and has_glazing_g(state.current.network)
     return {EXCESS_SUN_EFFECT} if judged_after else set()
 

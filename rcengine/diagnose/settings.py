@@ -53,8 +53,9 @@ class DiagnoseSettings:
     the vocabulary acts over hours (the sun's course, schedules, the mass's and an emitter's
     hours-long time constants), and a six-month record at a logger's 5 minutes took 74 s to
     judge against 18 s at 30 minutes; excess_sun: a model with declared glazing has the opaque
-    sun judged on its own once the selection has ended, from sun the glazing admits beyond glass
-    (``excess_sun``), and in the selection's rounds only as a rival to an effect that passes;
+    sun judged on its own once the selection has ended, from sun its apertures admit beyond what
+    the declared glazing could as glass, against undeclared glazing (``excess_sun``), and in the
+    selection's rounds only as a rival to an effect that passes;
     clock_check: the building's summer-time readings are re-aligned by an hour where the base
     model fits the weather clearly better so (a logger on standard time all year, ``clock``)."""
 
