@@ -82,7 +82,7 @@ def sun_as_glazing_g(fit: Fit) -> float | None:
     alone would need to admit it: Σ_k a_k · mean(s_k) / mean(solar_window) over the training
     period, a_k the steady aperture of solar input s_k (its settled heat into the room per unit,
     over the heater's). None without declared glazing. [-]"""
-    if declared_g(fit.network, fit.params) is None:
+    if not has_glazing_g(fit.network):
         return None
     frame = fit.split.train.frame
     apertures = solar_apertures(fit.network, fit.params)
@@ -189,11 +189,11 @@ def _capped_fits(problem: Problem, current: Fit, exts: list[Extension], g: float
     settings = problem.settings
     models = [(current.network, current.options, {})]
     models += [(ext.network, ext.signals, ext.neutral) for ext in exts]
-    capped = {n: current.params[n] * G_GLAZING_MAX / g for n in sun_parameters(current.network)}
+    capped = sun_parameters(current.network)
     jobs = []
     for network, options, neutral in models:
         network = held_to_glass(network, current.params, g)
-        at_cap = {n: max(network.parameters[n].lower, v) for n, v in capped.items()}
+        at_cap = {n: network.parameters[n].upper for n in capped}
         jobs.append(
             FitJob(
                 network,
