@@ -23,7 +23,13 @@ from rcengine.columns import (
     solar_orientation_signal,
 )
 from rcengine.diagnose import candidates
-from rcengine.diagnose.candidates import CANDIDATES, Context, Extension, heater_saturated
+from rcengine.diagnose.candidates import (
+    CANDIDATES,
+    SOIL_LAYER_R,
+    Context,
+    Extension,
+    heater_saturated,
+)
 from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.plausibility import GROUND_TEMPERATURE_MARGIN_K, SKY_H_R_TYPICAL, assess
 from rcengine.diagnose.response import node_responses
@@ -99,8 +105,14 @@ def _window(ext: Extension, g: float) -> dict[str, float]:
 
 
 def _ground(ext: Extension, u_floor: float, t_ground: float) -> dict[str, float]:
-    """r_floor and q_ground for a floor U-value and a mean ground temperature."""
-    return {"r_floor": 1 / u_floor, "q_ground": (t_ground - ext.detail["ground_base_c"]) * u_floor}
+    """r_floor and q_ground for a floor U-value and a mean ground temperature (q_ground the
+    ground's warming ΔT over the resistance it is seen through: the layer of soil's, else the
+    floor's)."""
+    seen_through = ext.detail.get("soil_layer_r_m2k_w") or 1 / u_floor
+    return {
+        "r_floor": 1 / u_floor,
+        "q_ground": (t_ground - ext.detail["ground_base_c"]) / seen_through,
+    }
 
 
 def _between(ext: Extension) -> float:
@@ -446,18 +458,62 @@ def test_seasonal_ground_temperature_by_hand():
 
 def test_the_ground_candidate_reads_the_soil_at_both_ends_of_iso_13370_s_lags(gain_context):
     """A month's lag by default, a month and a half (an insulated floor) as its alternative: the
-    same parameters, the soil read 1.66 and 2.49 m deep, each judged against its own soil."""
+    same parameters, the soil read 1.66 and 2.49 m deep, each judged against its own soil; and
+    each again through ISO 52016-1's layer of soil."""
     ground = CANDIDATES["ground_coupling"](gain_context)
-    (deeper,) = ground.alternatives
+    deeper, layered, layered_deeper = ground.alternatives
     assert ground.signals.ground_depth_m == pytest.approx(1.66, abs=0.005)
     assert deeper.signals.ground_depth_m == pytest.approx(2.49, abs=0.005)
     assert ground.detail["ground_lag_months"] == pytest.approx(1.0)
     assert deeper.detail["ground_lag_months"] == pytest.approx(1.5)
+    for version, lag_of in ((layered, ground), (layered_deeper, deeper)):
+        assert version.signals == lag_of.signals
+        assert version.detail["soil_layer_r_m2k_w"] == SOIL_LAYER_R
+    assert ground.detail["soil_layer_r_m2k_w"] is None
     assert deeper.new_parameters == ground.new_parameters and not deeper.alternatives
     times, t_out = gain_context.data.times, gain_context.train["t_out"].to_numpy(dtype=float)
     for version in (ground, deeper):
         soil = seasonal_ground_temperature(times, t_out, 45.07, version.signals.ground_depth_m)
         assert version.detail["ground_base_c"] == pytest.approx(np.mean(soil))
+
+
+def test_the_layer_of_soil_is_iso_52016_s_under_the_footprint(gain_context):
+    """0.5 m of soil (λ 2.0 W/(mK), ρc 2.0 MJ/(m³K)) per m² of the footprint between the soil
+    read and the floor, r_floor from the layer to the interior mass."""
+    (layered,) = [
+        v
+        for v in CANDIDATES["ground_coupling"](gain_context).alternatives
+        if v.detail["soil_layer_r_m2k_w"] and v.detail["ground_lag_months"] == pytest.approx(1.0)
+    ]
+    net, footprint = layered.network, SMALL.footprint_area
+    (soil,) = [c for c in net.capacitors if c.node == "soil"]
+    assert soil.capacity * soil.factor == pytest.approx(1.0e6 * footprint)
+    (layer,) = [r for r in net.resistors if {r.a, r.b} == {T_GROUND, "soil"}]
+    assert layer.resistance * layer.factor == pytest.approx(0.25 / footprint)
+    (floor,) = [r for r in net.resistors if r.resistance == "r_floor"]
+    assert {floor.a, floor.b} == {"soil", "int"}
+
+
+@pytest.mark.parametrize("layer", [False, True])
+def test_the_soil_s_constant_heat_is_a_warmer_ground(gain_context, layer):
+    """The soil's warming by the building enters as the constant heat of its Norton equivalent,
+    ΔT/R on the node the ground is seen from (the floor's without the layer, the layer's with
+    it): settled, q_ground raises the room as a ground ΔT = q·R warmer does, and the ground
+    temperature read for plausibility is that one."""
+    ground = CANDIDATES["ground_coupling"](gain_context)
+    (version,) = [
+        v
+        for v in (ground, *ground.alternatives)
+        if bool(v.detail["soil_layer_r_m2k_w"]) == layer
+        and v.detail["ground_lag_months"] == pytest.approx(1.0)
+    ]
+    params = {**TRUTH_BASIC, **_ground(version, 0.8, version.detail["ground_base_c"] + 3.0)}
+    r = SOIL_LAYER_R if layer else params["r_floor"]
+    gains = steady_state_gains(version.network, params)
+    assert gains[UNIT] == pytest.approx(gains[T_GROUND] * 3.0)
+    t_ground = assess(version, params).magnitudes["t_ground"]["value"]
+    assert t_ground == pytest.approx(version.detail["ground_base_c"] + 3.0)
+    assert params["q_ground"] * r == pytest.approx(3.0)
 
 
 def test_the_annual_mean_s_standard_error_covers_the_weather_of_a_season():
@@ -569,14 +625,19 @@ def test_a_candidate_left_out_is_exactly_the_model_it_extended(gain_context, eff
     """The backward check's model without a finding: the floor's path to the ground open
     (r_floor = ∞); the added storage without capacity or coupling, so its node leaves; the
     emitter without capacity and joined to the air (r = 0), so q_hvac enters the air again. The
-    same states, matrices and inputs as the model before it was added."""
-    candidate = CANDIDATES[effect](gain_context)
-    without = candidate.network.fixed(candidate.absent)
-    assert without.states == gain_context.network.states
-    compiled, base = without.compile(), gain_context.network.compile()
-    assert compiled.input_names == base.input_names
-    for a, b in zip(compiled.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True):
-        np.testing.assert_allclose(a, b, rtol=1e-12)
+    same states, matrices and inputs as the model before it was added (the ground's layer of
+    soil leaves with the floor's path)."""
+    first = CANDIDATES[effect](gain_context)
+    versions = (first, *first.alternatives) if effect == "ground_coupling" else (first,)
+    base = gain_context.network.compile()
+    for candidate in versions:
+        without = candidate.network.fixed(candidate.absent)
+        assert without.states == gain_context.network.states
+        compiled = without.compile()
+        assert compiled.input_names == base.input_names
+        pairs = zip(compiled.state_space(TRUTH_BASIC), base.state_space(TRUTH_BASIC), strict=True)
+        for a, b in pairs:
+            np.testing.assert_allclose(a, b, rtol=1e-12)
 
 
 def test_a_radiant_emitter_warms_the_mass_as_well_as_the_air(gain_context, loss_context):

@@ -712,6 +712,12 @@ def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
     return {"metered_w_m2": level} if level > 0.0 else {}
 
 
+# ISO 52016-1's virtual layer of soil between a floor on the ground and the ground temperature:
+# 0.5 m of soil at λ = 2.0 W/(mK) and ρc = 2.0 MJ/(m³K) (ISO 13370's sand or gravel). [m²K/W],
+# [J/(K·m²)]
+SOIL_LAYER_R, SOIL_LAYER_C = 0.5 / 2.0, 0.5 * 2.0e6
+
+
 def ground_coupling(ctx: Context) -> Extension | Skipped:
     """Heat exchange through the floor with the soil under it, into the interior mass.
 
@@ -723,7 +729,12 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     T_base + q·r.
     The lag depends on the floor's insulation, which the building description does not give:
     the soil is read at the model's lag (a month by default), and at ISO 13370's other lags
-    (``GROUND_LAGS_S``) as alternatives.
+    (``GROUND_LAGS_S``) as alternatives. Each lag is also offered through ISO 52016-1's virtual
+    layer of soil (``SOIL_LAYER_R``, ``SOIL_LAYER_C``) between the floor and the soil read: a
+    heated slab warms the soil under it over days and gets that heat back when the heating
+    stops (a holiday, a cold snap), which a floor straight onto its boundary temperature
+    answers at once; without the layer, a storage added to the air (``thermal_mass``) took that
+    part first and the ground was read at a soil colder than any.
     """
     effect = "ground_coupling"
     if T_GROUND in ctx.network.signals:
@@ -731,20 +742,31 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     own = ctx.signals.ground_depth_m
     depths = [ground_depth(lag) for lag in GROUND_LAGS_S]
     depths = [own, *(z for z in depths if not np.isclose(z, own))]
+    readings = list(zip(depths, _ground_temperatures(ctx, depths), strict=True))
     first, *others = (
-        _ground_at(ctx, replace(ctx.signals, ground_depth_m=z), soil)
-        for z, soil in zip(depths, _ground_temperatures(ctx, depths), strict=True)
+        _ground_at(ctx, replace(ctx.signals, ground_depth_m=z), soil, layer)
+        for layer in (False, True)
+        for z, soil in readings
     )
     return replace(first, alternatives=tuple(others))
 
 
-def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> Extension:
+def _ground_at(
+    ctx: Context, signals: SignalOptions, soil: dict[str, float], layer: bool
+) -> Extension:
     """``ground_coupling`` with the soil read at ``signals.ground_depth_m``, judged against
-    ``soil`` (``_ground_temperatures`` at that depth)."""
+    ``soil`` (``_ground_temperatures`` at that depth); with ``layer``, through ISO 52016-1's
+    virtual layer of soil under the floor (``SOIL_LAYER_R``, ``SOIL_LAYER_C``), whose own
+    storage a slab on the ground charges over days and gives back through a holiday."""
     effect = "ground_coupling"
     net = ctx.network.copy(_name(ctx.network, effect))
     footprint = ctx.building.footprint_area
     target = mass_node(net)
+    soil_side, offset_r = T_GROUND, None
+    if layer:
+        soil_side, offset_r = "soil", SOIL_LAYER_R
+        net.add_capacitor(soil_side, SOIL_LAYER_C, factor=footprint)
+        net.add_resistor(T_GROUND, soil_side, SOIL_LAYER_R, factor=1.0 / footprint)
     net.add_parameter(
         Parameter(
             "r_floor",
@@ -760,17 +782,21 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
             "W/m²",
             -20.0,
             60.0,
-            "constant heat from the soil's warming by the building, U·ΔT, per m² of ground floor",
+            "constant heat from the soil's warming by the building, ΔT over the resistance the "
+            "ground is seen through (the floor's, or the layer of soil's), per m² of ground floor",
         )
     )
-    net.add_resistor(T_GROUND, target, "r_floor", factor=1.0 / footprint)
-    net.add_heat_input(UNIT, target, "q_ground", factor=footprint)
+    net.add_resistor(soil_side, target, "r_floor", factor=1.0 / footprint)
+    # The soil's warming by the building, ΔT on the ground temperature, is the constant heat
+    # ΔT/R of its Norton equivalent, on the node the ground temperature is seen from.
+    heated = target if offset_r is None else soil_side
+    net.add_heat_input(UNIT, heated, "q_ground", factor=footprint)
     return Extension(
         effect,
         net,
         signals,
         ("r_floor", "q_ground"),
-        ((T_GROUND, target), (UNIT, target)),
+        ((T_GROUND, heated), (UNIT, heated)),
         neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
         absent={"r_floor": np.inf, "q_ground": 0.0},
         detail={
@@ -778,6 +804,7 @@ def _ground_at(ctx: Context, signals: SignalOptions, soil: dict[str, float]) -> 
             "ground_floor_area_m2": footprint,
             "ground_depth_m": signals.ground_depth_m,
             "ground_lag_months": 12.0 * ground_lag(signals.ground_depth_m) / YEAR_S,
+            "soil_layer_r_m2k_w": offset_r,
             **soil,
         },
     )

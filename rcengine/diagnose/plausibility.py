@@ -330,11 +330,12 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """Floor U-value 1/r_floor and the fitted mean ground temperature: the undisturbed soil's
-    T_base raised by q_ground·r_floor (the constant heat q_ground is U·(T_g − T_base)); the lag
-    of the soil it was read at, reported only."""
+    T_base raised by q_ground·R (the constant heat q_ground is (T_g − T_base)/R, R the floor's
+    r_floor, or the layer of soil's where the version has one); the lag of the soil it was read
+    at, reported only."""
     d = ext.detail
     r = params["r_floor"]
-    t_ground = d["ground_base_c"] + params["q_ground"] * r
+    t_ground = d["ground_base_c"] + params["q_ground"] * (d.get("soil_layer_r_m2k_w") or r)
     low = (
         min(d["ground_base_c"], d["outdoor_mean_c"])
         - GROUND_TEMPERATURE_MARGIN_K

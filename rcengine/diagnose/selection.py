@@ -577,14 +577,24 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
         if "follows" in worse.detail:
             best.detail["use_not_taken"] = _version_words(worse)
         if "ground_lag_months" in worse.detail:
-            lag, how = worse.detail["ground_lag_months"], _version_words(worse)
-            best.detail["ground_lag_not_taken"] = f"{lag:.1f} months ({how})"
+            not_taken = (
+                best.detail.get("ground_lag_not_taken"),
+                worse.detail.get("ground_lag_not_taken"),
+                f"{_ground_words(worse)} ({_version_words(worse)})",
+            )
+            best.detail["ground_lag_not_taken"] = "; ".join(w for w in not_taken if w)
         if "radiant_to" in worse.detail:
             best.detail["radiant_not_taken"] = _version_words(worse)
         elif "radiant_to" in best.detail:
             best.detail["convective_not_taken"] = _version_words(worse)
         chosen[f.effect] = best
     return list(chosen.values())
+
+
+def _ground_words(f: Finding) -> str:
+    """A ground version's reading: its lag, and the layer of soil where it has one."""
+    words = f"{f.detail['ground_lag_months']:.1f} months"
+    return f"{words} through the layer of soil" if f.detail.get("soil_layer_r_m2k_w") else words
 
 
 def _version_words(f: Finding) -> str:
