@@ -762,9 +762,9 @@ def _ground_at(
     net = ctx.network.copy(_name(ctx.network, effect))
     footprint = ctx.building.footprint_area
     target = mass_node(net)
-    soil_side, offset_r = T_GROUND, None
+    # The node the floor reaches the soil at: the soil read, or the layer's own.
+    soil_side = "soil" if layer else T_GROUND
     if layer:
-        soil_side, offset_r = "soil", SOIL_LAYER_R
         net.add_capacitor(soil_side, SOIL_LAYER_C, factor=footprint)
         net.add_resistor(T_GROUND, soil_side, SOIL_LAYER_R, factor=1.0 / footprint)
     net.add_parameter(
@@ -789,7 +789,7 @@ def _ground_at(
     net.add_resistor(soil_side, target, "r_floor", factor=1.0 / footprint)
     # The soil's warming by the building, ΔT on the ground temperature, is the constant heat
     # ΔT/R of its Norton equivalent, on the node the ground temperature is seen from.
-    heated = target if offset_r is None else soil_side
+    heated = soil_side if layer else target
     net.add_heat_input(UNIT, heated, "q_ground", factor=footprint)
     return Extension(
         effect,
@@ -804,7 +804,7 @@ def _ground_at(
             "ground_floor_area_m2": footprint,
             "ground_depth_m": signals.ground_depth_m,
             "ground_lag_months": 12.0 * ground_lag(signals.ground_depth_m) / YEAR_S,
-            "soil_layer_r_m2k_w": offset_r,
+            "soil_layer_r_m2k_w": SOIL_LAYER_R if layer else None,
             **soil,
         },
     )
