@@ -2,6 +2,8 @@
 
 import math
 import warnings
+from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -9,8 +11,19 @@ import pytest
 
 from rcengine.building import Building
 from rcengine.dataset import Dataset
+from rcengine.diagnose import selection
 from rcengine.diagnose.declared import with_declared_glazing
-from rcengine.diagnose.health import FitQuality, check_health, fit_quality, same_time_earlier
+from rcengine.diagnose.fitting import FitJob, split_data
+from rcengine.diagnose.health import (
+    BINDING_SHARE,
+    FitQuality,
+    check_health,
+    fit_quality,
+    on_bounds,
+    relaxed_bounds,
+    same_time_earlier,
+)
+from rcengine.diagnose.settings import FOLD_REFIT, DiagnoseSettings, split_time
 from rcengine.estimation.estimator import Estimator
 from rcengine.estimation.objective import Objective
 from rcengine.exceptions import ConvergenceWarning, ModelError
@@ -18,7 +31,7 @@ from rcengine.io.timeseries import read_timeseries
 from rcengine.models import MODELS, get_model
 from rcengine.models.bounds import building_bounds
 from rcengine.models.physical import read, solar_apertures, time_constants_h, ua
-from rcengine.signals import prepare
+from rcengine.signals import SignalOptions, prepare
 
 from .synthetic import BUILDING, TRUTH_BASIC, TRUTH_SUN, basic_reference, weather_and_gains
 from .test_models import THESIS_TABLE_2_3, with_surfaces
@@ -177,6 +190,70 @@ def test_a_parameter_on_a_bound_is_named_with_its_physics():
     assert health.reasons[0].startswith(f"c_wall ended on its upper bound {upper:.3g} J/(K·m²)")
     assert "stores more heat than any construction of this building could" in health.reasons[0]
     assert health.summary().startswith("the base model cannot represent this building: c_wall")
+
+
+@pytest.mark.parametrize("gain", [0.0, 0.005, BINDING_SHARE - 1e-9])
+def test_a_bound_the_data_do_not_press_on_is_a_note_not_a_reason(gain):
+    """A fit that gains under ``BINDING_SHARE`` past its bound rests on it because it does without
+    that element: the base model is healthy and the bound is noted."""
+    b = building_700()
+    net = get_model("basic", b, bounds="building")
+    upper = net.parameters["r_int"].upper
+    fitted = {**TRUTH_BASIC, "r_int": upper}
+    health = check_health(net, fitted, GOOD, building=b, pressure={"r_int": gain})
+    assert health.healthy and health.on_bounds == ("r_int",)
+    assert health.notes == (
+        f"r_int ended on its upper bound {upper:.3g} m²K/W, but a fit past it gains {gain:.1%} "
+        "of the training RMSE: the data do not press on it (the model does without that element)",
+    )
+
+
+def test_a_bound_the_data_press_on_is_a_reason_with_what_a_fit_past_it_gains():
+    b = building_700()
+    net = get_model("basic", b, bounds="building")
+    fitted = {**TRUTH_BASIC, "c_air": net.parameters["c_air"].lower}
+    health = check_health(net, fitted, GOOD, building=b, pressure={"c_air": 0.13})
+    assert health.verdict == "inadequate"
+    (reason,) = health.reasons
+    assert "stores less heat than even the lightest construction" in reason
+    assert reason.endswith("(a fit past it gains 13%)")
+    assert health.pressure == {"c_air": 0.13} and not health.resting and not health.settled
+
+
+def test_a_relaxed_bound_moves_one_bound_a_decade_outward():
+    net = get_model("basic", building_700(), bounds="building")
+    params = {**TRUTH_BASIC, "r_int": net.parameters["r_int"].upper}
+    params["c_air"] = net.parameters["c_air"].lower
+    found = {b.name: b for b in on_bounds(net, params)}
+    assert set(found) == {"r_int", "c_air"}
+    assert found["r_int"].at_upper and not found["c_air"].at_upper
+    for name, moved in (("r_int", 1), ("c_air", 0)):
+        relaxed = relaxed_bounds(net, found[name])
+        original = (net.parameters[name].lower, net.parameters[name].upper)
+        assert relaxed[name][moved] == pytest.approx(original[moved] * (10.0 if moved else 0.1))
+        assert relaxed[name][1 - moved] == original[1 - moved]
+        others = {k: v for k, v in relaxed.items() if k != name}
+        assert others == {k: (p.lower, p.upper) for k, p in net.parameters.items() if k != name}
+
+
+@pytest.mark.parametrize(("share_of_truth", "pressed"), [(1 / 3, True), (1.0, False)])
+def test_the_data_press_on_a_bound_short_of_the_truth_only(share_of_truth, pressed):
+    """A 3R3C fitted with the air's capacity bounded at a third of the truth presses on that
+    bound (a refit past it fits better by far more than ``BINDING_SHARE``); bounded at the truth,
+    it rests on the bound and gains nothing past it."""
+    frame = weather_and_gains(21)
+    frame["t_in"] = basic_reference(frame, TRUTH_BASIC, (14.0, 20.0, 23.0))
+    network = get_model("basic", BUILDING, frame.columns)
+    bound = TRUTH_BASIC["c_air"] * share_of_truth
+    network.parameters["c_air"] = replace(network.parameters["c_air"], upper=bound)
+    boundary = split_time(frame, 0.5, BUILDING.location.timezone)
+    split = split_data(frame, BUILDING, network, SignalOptions(), boundary)
+    start = {**TRUTH_BASIC, "c_air": bound}
+    fit = FitJob(network, SignalOptions(), split, FOLD_REFIT, 0, [start]).run()
+    problem = SimpleNamespace(settings=DiagnoseSettings(workers=1))
+    pressure = selection._pressure_on_bounds(problem, fit)
+    assert "c_air" in pressure
+    assert (pressure["c_air"] >= BINDING_SHARE) is pressed, pressure
 
 
 def test_a_zero_aperture_is_a_note_not_a_reason():

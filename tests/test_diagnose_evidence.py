@@ -76,6 +76,26 @@ def test_verdict_says_the_base_model_is_inadequate_and_what_was_found_against_it
     assert text.endswith(f"— {healed}: missing: wind_infiltration"), text
 
 
+def test_a_base_model_resting_on_a_bound_is_healthy_but_still_offered_the_repair_step():
+    """A bound the data do not press on is no reason against the base model (the verdict does not
+    call it inadequate), but the model is not settled: the structural step is still tried, and
+    where it is taken the verdict names it beside what was found."""
+    resting = (
+        "r_int ended on its upper bound 0.97 m²K/W, but a fit past it gains 0.2% of the training "
+        "RMSE: the data do not press on it (the model does without that element)"
+    )
+    health = Health(reasons=(), on_bounds=("r_int",), notes=(resting,), resting=(resting,))
+    assert health.healthy and health.verdict == "healthy" and not health.settled
+    assert HEALTHY.settled and not CRIPPLED.settled
+    wind = _finding("wind_infiltration", True)
+    assert verdict([wind], health) == "missing: wind_infiltration"
+    repair = _finding("thermal_mass", True, round=0, baseline_repair=True)
+    assert verdict([repair, wind], health) == (
+        "missing: wind_infiltration (against the base model with thermal_mass: without it, "
+        "parameters rested on bounds the data do not press on)"
+    )
+
+
 def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
     folds = rolling_folds(
         pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3

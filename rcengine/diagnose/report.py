@@ -302,9 +302,14 @@ def verdict(findings: list[Finding], health: Health | None) -> str:
     the healthy model reached by a repair step, or against the inadequate one when none was."""
     missing = [f.effect for f in findings if f.accepted and not f.baseline_repair]
     found = "missing: " + ", ".join(missing) if missing else "nothing missing"
-    if health is None or health.healthy:
-        return found
     repairs = [f.effect for f in findings if f.accepted and f.baseline_repair]
+    if health is None or health.healthy:
+        if not repairs:
+            return found
+        return (
+            f"{found} (against the base model with {', '.join(repairs)}: without it, parameters "
+            "rested on bounds the data do not press on)"
+        )
     dropped = [f.effect for f in findings if not f.accepted and f.baseline_repair]
     if repairs:
         against = f"healthy with {', '.join(repairs)}, then {found}"
@@ -316,13 +321,15 @@ def verdict(findings: list[Finding], health: Health | None) -> str:
 
 
 def health_dict(health: Health, quality: FitQuality) -> dict:
-    """The base model's health for the report: verdict, reasons, notes, parameters on bounds,
-    and its test RMSE against the naive forecasts' [K]."""
+    """The base model's health for the report: verdict, reasons, notes, parameters on bounds
+    and what a fit past each gains (``bound_pressure``, a share of the training RMSE), and its
+    test RMSE against the naive forecasts' [K]."""
     return {
         "verdict": health.verdict,
         "reasons": list(health.reasons),
         "notes": list(health.notes),
         "parameters_on_bounds": list(health.on_bounds),
+        "bound_pressure": dict(health.pressure),
         "rmse_test": quality.rmse,
         "naive_rmse_test": quality.naive,
     }

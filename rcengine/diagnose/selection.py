@@ -16,9 +16,11 @@
    the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
 Before any of this the base model (fitted within bounds derived from the building) is checked for
-health (``health``): against a crippled base model any flexible extension "wins". An inadequate
-one is repaired by the structural ``thermal_mass`` step when that makes it healthy; otherwise the
-candidates are still judged against it, and the verdict says so.
+health (``health``): against a crippled base model any flexible extension "wins". A base model
+that is inadequate, or rests a parameter on a bound the data do not press on (healthy, but
+perhaps of too low an order), is given the structural ``thermal_mass`` step, taken when it leaves
+no parameter on a bound; otherwise the candidates are still judged against the base model, and
+the verdict says whether it is inadequate.
 """
 
 from __future__ import annotations
@@ -61,7 +63,14 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
-from rcengine.diagnose.health import FitQuality, Health, check_health, fit_quality
+from rcengine.diagnose.health import (
+    FitQuality,
+    Health,
+    check_health,
+    fit_quality,
+    on_bounds,
+    relaxed_bounds,
+)
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
@@ -175,10 +184,10 @@ def _diagnose(
         frame = realigned(frame, clock.offset_h, timezone)
         problem, left_out = _problem(frame, building, settings, say)
         baseline = _baseline(problem, model)
-    quality, health = _health(problem, baseline)
+    quality, health = _health(problem, baseline, weigh_bounds=True)
     locate = _locate(baseline, building)
     state = Selection(baseline)
-    if not health.healthy:
+    if not health.settled:
         problem.say(f"  {health.summary()}")
         _repair(problem, state)
     _select(problem, state)
@@ -283,21 +292,53 @@ def _base_model(problem: Problem, model: str, bounds: str) -> RCNetwork:
     return with_declared_glazing(network, problem.building, mass_node(network))
 
 
-def _health(problem: Problem, fit: Fit) -> tuple[FitQuality, Health]:
-    """The fitted model's test error against naive forecasts, and its health verdict."""
+def _health(problem: Problem, fit: Fit, weigh_bounds: bool = False) -> tuple[FitQuality, Health]:
+    """The fitted model's test error against naive forecasts, and its health verdict; with
+    ``weigh_bounds``, a bound counts against it only where the data press on it (the base
+    model's verdict), else every bound does (whether a repair step has settled it)."""
     quality = fit_quality(
         problem.frame[T_IN],
         fit.split.test.times,
         fit.simulated_test,
         problem.building.location.timezone,
     )
-    health = check_health(fit.network, fit.params, quality, building=problem.building)
+    health = check_health(
+        fit.network,
+        fit.params,
+        quality,
+        building=problem.building,
+        pressure=_pressure_on_bounds(problem, fit) if weigh_bounds else None,
+    )
     return quality, health
 
 
+def _pressure_on_bounds(problem: Problem, fit: Fit) -> dict[str, float]:
+    """Per parameter on a bound (not at a physical zero), the share of the training RMSE a refit
+    with that bound a decade further out gains (``health.relaxed_bounds``; least squares from
+    the fit, one batch): whether the data press on the bound or the fit merely rests there."""
+    settings = problem.settings
+    pressed = [b for b in on_bounds(fit.network, fit.params) if not b.physical_none]
+    jobs = [
+        FitJob(
+            fit.network,
+            fit.options,
+            fit.split,
+            settings.fold_preset,
+            settings.random_state,
+            [fit.params],
+            relaxed_bounds(fit.network, b),
+        )
+        for b in pressed
+    ]
+    refits = fit_many(jobs, settings.workers)
+    rmse_train = max(fit.rmse_train, 1e-12)  # an exact fit gains nothing anywhere
+    return {b.name: 1.0 - r.rmse_train / rmse_train for b, r in zip(pressed, refits, strict=True)}
+
+
 def _repair(problem: Problem, state: Selection) -> None:
-    """Add the structural ``thermal_mass`` step to an inadequate base model and continue from it
-    if that makes the model healthy with a plausible added capacity (a base model too low in
+    """Add the structural ``thermal_mass`` step to a base model that is inadequate or rests a
+    parameter on a bound, and continue from it if that leaves no parameter on any bound (the
+    every-bound health) with a plausible added capacity (a base model too low in
     order ends its capacities on their bounds); otherwise leave the base model as it is."""
     effect = "thermal_mass"
     if effect not in problem.settings.effects:
