@@ -86,6 +86,10 @@ def test_a_base_model_resting_on_a_bound_is_healthy_but_still_offered_the_repair
     )
     health = Health(reasons=(), on_bounds=("r_int",), notes=(resting,), resting=(resting,))
     assert health.healthy and health.verdict == "healthy" and not health.settled
+    assert health.summary() == (
+        f"the base model represents this building, resting on bounds the data do not press on: "
+        f"{resting}"
+    )
     assert HEALTHY.settled and not CRIPPLED.settled
     wind = _finding("wind_infiltration", True)
     assert verdict([wind], health) == "missing: wind_infiltration"

@@ -166,6 +166,11 @@ class Health:
         return self.healthy and not self.resting
 
     def summary(self) -> str:
+        if self.healthy and self.resting:
+            return (
+                "the base model represents this building, resting on bounds the data do not "
+                f"press on: {'; '.join(self.resting)}"
+            )
         if self.healthy:
             return "the base model represents this building"
         return "the base model cannot represent this building: " + "; ".join(self.reasons)
