@@ -35,11 +35,9 @@ from scripts.energyplus.testbed import SETS  # noqa: E402
 GAIN_BINS = (0.005, 0.01, 0.02, 0.03, float("inf"))
 
 
-def base_only(workers: int) -> DiagnoseSettings:
-    """The diagnosis up to its base model and the repair step, nothing judged after."""
-    return DiagnoseSettings(
-        max_rounds=0, excess_sun=False, effects=("thermal_mass",), workers=workers
-    )
+# The diagnosis up to its base model and the repair step, nothing judged after; one worker
+# process per case, the cases themselves run ``--jobs`` at a time.
+BASE_ONLY = DiagnoseSettings(max_rounds=0, excess_sun=False, effects=("thermal_mass",), workers=1)
 
 
 def state(health: dict) -> str:
@@ -48,16 +46,21 @@ def state(health: dict) -> str:
     return "resting" if health["bound_pressure"] else "settled"
 
 
-def _one(job: tuple[str, Path, str, int]) -> tuple[str, dict]:
-    key, folder, model, workers = job
-    report, _ = diagnose_folder(folder, model, settings=base_only(workers))
+def repaired(report: dict) -> bool:
+    """Was the repair step taken (and kept)?"""
+    return any(f["baseline_repair"] and f["accepted"] for f in report["findings"])
+
+
+def _one(job: tuple[str, Path, str]) -> tuple[str, dict]:
+    key, folder, model = job
+    report, _ = diagnose_folder(folder, model, settings=BASE_ONLY)
     return key, report
 
 
 def case_line(key: str, report: dict) -> str:
     health = report["baseline"]["health"]
     repair = health.get("repair") or {}
-    taken = any(f["baseline_repair"] and f["accepted"] for f in report["findings"])
+    taken = repaired(report)
     bounds = " ".join(f"{p} {g:+.1%}" for p, g in health["bound_pressure"].items()) or "-"
     tried = f"repair {'taken' if taken else repair.get('verdict', 'not tried')}"
     return f"{key:70s} {state(health):10s} {tried:21s} {bounds}"
@@ -78,9 +81,7 @@ def summary(reports: list[dict]) -> dict:
         "inadequate": states["inadequate"],
         "resting": states["resting"],
         "settled": states["settled"],
-        "repaired": sum(
-            any(f["baseline_repair"] and f["accepted"] for f in r["findings"]) for r in reports
-        ),
+        "repaired": sum(repaired(r) for r in reports),
         "bounds": len(gains),
         "bounds_by_gain": by_gain,
     }
@@ -98,7 +99,7 @@ def main() -> None:
     for name in args.set or ["testbed"]:
         folder, manifest, _ = read_set(name)
         jobs.extend(
-            (f"{name}/{case['case']}", folder / case["case"], case["model"], 1)
+            (f"{name}/{case['case']}", folder / case["case"], case["model"])
             for case in manifest
             if not args.cases or case["case"] in args.cases
         )
