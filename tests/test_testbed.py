@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from benchmarks.census import drift_lines, found_table
 from benchmarks.diagnose_testbed import (
     Result,
     confusion_matrix,
@@ -294,6 +295,29 @@ def test_scoring_null_counts_every_accepted_finding() -> None:
     assert not is_correct([], _report("thermal_mass"))
     assert false_findings([], _report("thermal_mass", "unmetered_gains")) == 2
     assert false_findings(["thermal_mass"], _report("thermal_mass", "unmetered_gains")) == 0
+
+
+def test_census_counts_a_pair_for_each_effect_right_only_when_both_are_found() -> None:
+    def case(effects: list[str], archetype: str, report: dict) -> tuple[dict, dict]:
+        base = {"baseline": {"rmse_train": 0.2, "rmse_test": 0.5}}
+        return {"effects": effects, "archetype": archetype}, {**report, **base}
+
+    pair = ["sky_radiation", "wind_infiltration"]
+    cases = [
+        case(pair, "heavy", _report("wind_infiltration")),
+        case(["sky_radiation"], "heavy", _report("sky_radiation")),
+        case([], "heavy", _report()),
+        case([], "light", _report("thermal_mass")),
+    ]
+    assert found_table(cases) == {
+        "none": {"heavy": [1, 1], "light": [0, 1]},
+        "sky_radiation": {"heavy": [1, 2]},
+        "wind_infiltration": {"heavy": [0, 1]},
+    }
+    # The drift is read on single effects and nulls alone: 0.5 / 0.2 K.
+    lines = drift_lines(cases)
+    assert len(lines) == 3 and all("test/train  2.5" in line for line in lines)
+    assert not any("wind_infiltration" in line for line in lines)
 
 
 def test_summary_counts_only_what_each_field_says() -> None:
