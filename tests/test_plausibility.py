@@ -160,8 +160,8 @@ CASES = {
     "ground_coupling": Case(
         lambda e: _ground(e, 0.5, _between(e)),
         lambda e: _ground(e, 3.5, _between(e)),
-        "U-value of the ground floor without its inside film (floor slab to soil): 3.5 W/(m²K) "
-        "exceeds any floor (≤ 3.03 W/(m²K))",
+        "U-value of the ground floor without its inside film (floor slab to the soil read): "
+        "3.5 W/(m²K) exceeds any floor (≤ 3.03 W/(m²K))",
     ),
     "sky_radiation": Case(
         lambda e: {"u_sky": 0.5},
@@ -264,6 +264,21 @@ def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
     ground = CANDIDATES["ground_coupling"](gain_context)
     hot = assess(ground, _ground(ground, 0.5, ground.detail["indoor_mean_c"] + 5.0))
     assert [p for p in hot.problems if p.startswith("mean ground temperature")], hot.problems
+
+
+def test_a_layered_floor_is_read_through_its_layer_of_soil(gain_context):
+    """ISO 13370's U spans the slab and the soil to where the ground temperature is read: the
+    layered version's r_floor plus ISO 52016-1's 0.25 m²K/W of soil. A floor of 5 W/(m²K) above
+    the layer is 2.2 through it, within an uninsulated slab's; one of 30 is 3.3 and exceeds it."""
+    ground = CANDIDATES["ground_coupling"](gain_context)
+    (layered, *_) = [e for e in ground.alternatives if e.detail["soil_layer_r_m2k_w"]]
+    soil = _between(layered)
+    for u_above, readback, plausible in ((5.0, 1 / 0.45, True), (30.0, 1 / (1 / 30 + 0.25), False)):
+        params = {**_ground(layered, u_above, soil)}
+        assessment = assess(layered, {**TRUTH_BASIC, **params})
+        assert assessment.magnitudes["u_floor"]["value"] == pytest.approx(readback)
+        floor = [p for p in assessment.problems if p.startswith("U-value of the ground floor")]
+        assert not floor if plausible else floor, assessment.problems
 
 
 def test_a_building_stands_on_its_footprint():

@@ -329,13 +329,17 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Floor U-value 1/r_floor and the fitted mean ground temperature: the undisturbed soil's
+    """Floor U-value 1/(r_floor + the layer of soil's R, where the version has one) and the
+    fitted mean ground temperature: the undisturbed soil's
     T_base raised by q_ground·R (the constant heat q_ground is (T_g − T_base)/R, R the floor's
     r_floor, or the layer of soil's where the version has one); the lag of the soil it was read
     at, reported only."""
     d = ext.detail
     r = params["r_floor"]
-    t_ground = d["ground_base_c"] + params["q_ground"] * (d.get("soil_layer_r_m2k_w") or r)
+    # ISO 13370's U (``U_FLOOR``) spans the floor and the soil down to where the ground
+    # temperature is read; ISO 52016-1's virtual layer of soil is part of that path.
+    layer = d.get("soil_layer_r_m2k_w") or 0.0
+    t_ground = d["ground_base_c"] + params["q_ground"] * (layer or r)
     low = (
         min(d["ground_base_c"], d["outdoor_mean_c"])
         - GROUND_TEMPERATURE_MARGIN_K
@@ -345,9 +349,9 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     return [
         Reading(
             "u_floor",
-            1.0 / r,
+            1.0 / (r + layer),
             "W/(m²K)",
-            "U-value of the ground floor without its inside film (floor slab to soil)",
+            "U-value of the ground floor without its inside film (floor slab to the soil read)",
             U_FLOOR,
             "floor",
         ),
