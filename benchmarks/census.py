@@ -34,12 +34,8 @@ REPORTS = ROOT / "docs" / "diagnosis"
 def committed(name: str) -> list[tuple[dict, dict]]:
     """(manifest entry, committed report) of every case of set ``name`` with a report."""
     _, manifest, _ = read_set(name)
-    folder = REPORTS / name
-    return [
-        (entry, json.loads((folder / f"{entry['case']}.json").read_text()))
-        for entry in manifest
-        if (folder / f"{entry['case']}.json").exists()
-    ]
+    reports = ((entry, REPORTS / name / f"{entry['case']}.json") for entry in manifest)
+    return [(entry, json.loads(path.read_text())) for entry, path in reports if path.exists()]
 
 
 def found_table(cases: list[tuple[dict, dict]]) -> dict[str, dict[str, list[int]]]:

@@ -274,8 +274,7 @@ def test_a_layered_floor_is_read_through_its_layer_of_soil(gain_context):
     (layered, *_) = [e for e in ground.alternatives if e.detail["soil_layer_r_m2k_w"]]
     soil = _between(layered)
     for u_above, readback, plausible in ((5.0, 1 / 0.45, True), (30.0, 1 / (1 / 30 + 0.25), False)):
-        params = {**_ground(layered, u_above, soil)}
-        assessment = assess(layered, {**TRUTH_BASIC, **params})
+        assessment = assess(layered, {**TRUTH_BASIC, **_ground(layered, u_above, soil)})
         assert assessment.magnitudes["u_floor"]["value"] == pytest.approx(readback)
         floor = [p for p in assessment.problems if p.startswith("U-value of the ground floor")]
         assert not floor if plausible else floor, assessment.problems

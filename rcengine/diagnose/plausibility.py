@@ -330,10 +330,9 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """Floor U-value 1/(r_floor + the layer of soil's R, where the version has one) and the
-    fitted mean ground temperature: the undisturbed soil's
-    T_base raised by q_ground·R (the constant heat q_ground is (T_g − T_base)/R, R the floor's
-    r_floor, or the layer of soil's where the version has one); the lag of the soil it was read
-    at, reported only."""
+    fitted mean ground temperature: the undisturbed soil's T_base raised by q_ground·R (the
+    constant heat q_ground is (T_g − T_base)/R, R the floor's r_floor, or the layer of soil's
+    where the version has one); the lag of the soil it was read at, reported only."""
     d = ext.detail
     r = params["r_floor"]
     # ISO 13370's U (``U_FLOOR``) spans the floor and the soil down to where the ground
