@@ -25,41 +25,49 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
-from benchmarks.diagnose_testbed import NONE, is_correct, read_set  # noqa: E402
+from benchmarks.diagnose_testbed import (  # noqa: E402
+    NONE,
+    Result,
+    read_set,
+    select,
+    stored_results,
+)
 from scripts.energyplus.testbed import SETS  # noqa: E402
 
 REPORTS = ROOT / "docs" / "diagnosis"
 
 
-def committed(name: str) -> list[tuple[dict, dict]]:
-    """(manifest entry, committed report) of every case of set ``name`` with a report."""
-    _, manifest, _ = read_set(name)
-    reports = ((entry, REPORTS / name / f"{entry['case']}.json") for entry in manifest)
-    return [(entry, json.loads(path.read_text())) for entry, path in reports if path.exists()]
+def committed(name: str) -> list[Result]:
+    """Every case of set ``name`` with a committed report, as the run that wrote it stored it."""
+    folder = REPORTS / name
+    _, manifest, split = read_set(name)
+    chosen = select(manifest, split, None, ())
+    reported = [
+        (entry, half) for entry, half in chosen if (folder / f"{entry['case']}.json").exists()
+    ]
+    return stored_results(folder, reported)
 
 
-def found_table(cases: list[tuple[dict, dict]]) -> dict[str, dict[str, list[int]]]:
+def found_table(cases: list[Result]) -> dict[str, dict[str, list[int]]]:
     """{effect: {archetype: [right, cases]}}, the nulls under ``none``."""
     table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0]))
-    for entry, report in cases:
-        right = is_correct(entry["effects"], report)
-        for effect in entry["effects"] or [NONE]:
-            cell = table[effect][entry["archetype"]]
-            cell[0] += right
+    for r in cases:
+        for effect in r.case["effects"] or [NONE]:
+            cell = table[effect][r.case["archetype"]]
+            cell[0] += r.correct
             cell[1] += 1
     return {e: dict(sorted(by.items())) for e, by in sorted(table.items())}
 
 
-def drift_lines(cases: list[tuple[dict, dict]]) -> list[str]:
+def drift_lines(cases: list[Result]) -> list[str]:
     """Per archetype and effect concealed alone (or none): the base model's test RMSE over its
     training RMSE, median (range, cases)."""
     ratios: dict[tuple[str, str], list[float]] = defaultdict(list)
-    for entry, report in cases:
-        if len(entry["effects"]) > 1:
+    for r in cases:
+        if len(r.case["effects"]) > 1:
             continue
-        base = report["baseline"]
-        effect = entry["effects"][0] if entry["effects"] else NONE
-        ratios[entry["archetype"], effect].append(base["rmse_test"] / base["rmse_train"])
+        base = r.report["baseline"]
+        ratios[r.case["archetype"], r.truth].append(base["rmse_test"] / base["rmse_train"])
     return [
         f"{archetype:10s} {effect:22s} test/train {statistics.median(v):4.1f} "
         f"({min(v):.1f}–{max(v):.1f}, {len(v)} cases)"
@@ -79,8 +87,9 @@ def main() -> None:
         print(f"{effect:22s} {cells}")
     print()
     print("\n".join(drift_lines(cases)))
-    correct = sum(is_correct(entry["effects"], report) for entry, report in cases)
-    print(json.dumps({"cases": len(cases), "correct": correct, "found": table}))
+    print(
+        json.dumps({"cases": len(cases), "correct": sum(r.correct for r in cases), "found": table})
+    )
 
 
 if __name__ == "__main__":

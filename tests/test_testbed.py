@@ -298,9 +298,9 @@ def test_scoring_null_counts_every_accepted_finding() -> None:
 
 
 def test_census_counts_a_pair_for_each_effect_right_only_when_both_are_found() -> None:
-    def case(effects: list[str], archetype: str, report: dict) -> tuple[dict, dict]:
+    def case(effects: list[str], archetype: str, report: dict) -> Result:
         base = {"baseline": {"rmse_train": 0.2, "rmse_test": 0.5}}
-        return {"effects": effects, "archetype": archetype}, {**report, **base}
+        return _result(effects, "heldout", {**report, **base}, archetype=archetype)
 
     pair = ["sky_radiation", "wind_infiltration"]
     cases = [
