@@ -25,27 +25,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 
-from benchmarks.diagnose_testbed import (  # noqa: E402
-    NONE,
-    Result,
-    read_set,
-    select,
-    stored_results,
-)
+from benchmarks.diagnose_testbed import NONE, Result, set_results  # noqa: E402
 from scripts.energyplus.testbed import SETS  # noqa: E402
 
 REPORTS = ROOT / "docs" / "diagnosis"
 
 
 def committed(name: str) -> list[Result]:
-    """Every case of set ``name`` with a committed report, as the run that wrote it stored it."""
-    folder = REPORTS / name
-    _, manifest, split = read_set(name)
-    chosen = select(manifest, split, None, ())
-    reported = [
-        (entry, half) for entry, half in chosen if (folder / f"{entry['case']}.json").exists()
-    ]
-    return stored_results(folder, reported)
+    """Every case of set ``name`` from the reports committed under ``docs/diagnosis/<name>``."""
+    return set_results(name, REPORTS / name)
 
 
 def found_table(cases: list[Result]) -> dict[str, dict[str, list[int]]]:

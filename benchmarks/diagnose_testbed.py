@@ -199,6 +199,12 @@ def stored_results(out: Path, chosen: Sequence[tuple[dict, str]]) -> list[Result
     ]
 
 
+def set_results(name: str, folder: Path) -> list[Result]:
+    """Every case of set ``name`` from the reports a run wrote to ``folder``."""
+    _, manifest, split = read_set(name)
+    return stored_results(folder, select(manifest, split, None, ()))
+
+
 def case_line(r: Result) -> str:
     return (
         f"{r.case['case']:58s} {r.half:8s} concealed: {r.truth:45s} first: {r.first:22s} "

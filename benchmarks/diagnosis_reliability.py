@@ -31,9 +31,7 @@ sys.path.insert(0, str(ROOT))  # run as a file: make `benchmarks` importable
 from benchmarks.diagnose_testbed import (  # noqa: E402
     NONE,
     Result,
-    read_set,
-    select,
-    stored_results,
+    set_results,
 )
 from scripts.energyplus.testbed import SETS  # noqa: E402
 
@@ -98,8 +96,7 @@ def results_of(source: str) -> list[Result]:
     name, sep, folder = source.partition("=")
     if not sep or name not in SETS:
         raise SystemExit(f"expected SET=DIR with SET one of {', '.join(SETS)}, got {source!r}")
-    _, manifest, split = read_set(name)
-    return stored_results(Path(folder), select(manifest, split, None, ()))
+    return set_results(name, Path(folder))
 
 
 def main() -> None:
