@@ -99,6 +99,10 @@ class Dataset:
             mask &= self.frame.index < parse_instant(end, "end")
         return self._subset(mask)
 
+    def where(self, mask: np.ndarray) -> Dataset:
+        """The rows where ``mask`` holds; the others become gaps."""
+        return self._subset(np.asarray(mask, dtype=bool))
+
     def weekdays(self, timezone: str) -> Dataset:
         """Monday–Friday rows (local calendar), the thesis's "Selected period"."""
         local = self.frame.index.tz_convert(timezone)

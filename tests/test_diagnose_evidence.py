@@ -15,7 +15,12 @@ from rcengine.diagnose.folds import FoldEvidence, rolling_folds
 from rcengine.diagnose.health import Health
 from rcengine.diagnose.html import _residual_before, render
 from rcengine.diagnose.report import Finding, confirm_on_folds, reject_implausible, verdict
-from rcengine.diagnose.selection import MIN_HVAC_SHARE, _informative, _winner
+from rcengine.diagnose.selection import (
+    MIN_HVAC_SHARE,
+    _informative,
+    _not_the_excess_sun,
+    _winner,
+)
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
 from tests.test_diagnose import _hidden_gain
 
@@ -120,6 +125,64 @@ def test_a_single_split_winner_that_helps_in_few_folds_is_rejected():
     assert steady.folds["helped"] == 3 and steady.folds["pooled_rmse_test_before"] == 1.0
 
 
+def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season():
+    """The training half's three months may not pay for a facade's g-values; the folds' fits,
+    each over the season around its window, may. Only the BIC may be short: a candidate whose
+    test gain is too small never reaches the folds."""
+    folds = rolling_folds(
+        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
+    )
+    helps = _evidence([1, 1, 1], [0.6, 0.7, 0.8])
+
+    def short(season_bic: float) -> Finding:
+        finding = _finding(
+            "window_solar_gains", False, reason="rejected: ΔBIC +9.1", short_of_bic=True
+        )
+        finding.delta_bic = 9.1
+        confirm_on_folds(finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic)
+        return finding
+
+    paid = short(-21.8)
+    assert paid.accepted and paid.detail["season_delta_bic"] == -21.8
+    assert paid.reason.startswith(
+        "accepted: test RMSE 1.000 → 0.500 K (-50%); ΔBIC +9.1 on the training half, -21.8 over "
+        "the season"
+    )
+    assert "across folds: helps in 3 of 3 folds" in paid.reason
+    unpaid = short(-4.0)
+    assert not unpaid.accepted and unpaid.reason == (
+        "rejected: ΔBIC +9.1, -4.0 over the season (median of the folds' fits)"
+    )
+    assert unpaid.folds["helped"] == 3  # the evidence is reported either way
+    implausible = _finding("window_solar_gains", False, short_of_bic=True)
+    reject_implausible(implausible, {}, ["g-value of the glazing facing 210°: 1.2 exceeds any"])
+    assert not implausible.short_of_bic  # an implausible fit goes no further
+
+
+def test_the_season_does_not_pick_the_way_of_sun_beyond_glass():
+    """Where the model already lets in more sun than glass could, which way the excess comes in
+    is the excess-sun step's to judge after the selection, not the season's BIC before it."""
+
+    def short() -> list:
+        return [
+            (None, _finding(e, False, reason="rejected: ΔBIC +9.1", short_of_bic=True))
+            for e in ("window_solar_gains", "opaque_solar_gains", "sky_radiation")
+        ]
+
+    within = short()
+    assert _not_the_excess_sun(within, 0.6) == within  # within glass: all go to the season
+    assert _not_the_excess_sun(within, None) == within  # no declared glazing
+    beyond = short()
+    kept = _not_the_excess_sun(beyond, 1.4)
+    assert [f.effect for _, f in kept] == ["sky_radiation"]
+    window = beyond[0][1]
+    assert not window.accepted and not window.short_of_bic
+    assert window.reason == (
+        "rejected: ΔBIC +9.1; the model's sun is already beyond glass (as g = 1.40): the "
+        "excess-sun step judges which way it comes in"
+    )
+
+
 def test_a_fold_trained_without_heating_but_tested_with_it_is_left_out():
     times = pd.date_range("2016-10-01", "2017-01-01", freq="1h", tz="UTC")
     folds = rolling_folds(times, "Europe/Rome", 28, 14, 3)
@@ -149,6 +212,20 @@ def test_of_two_passing_candidates_the_head_to_head_winner_is_taken_and_the_othe
     assert "better in 1 of 3 folds" in opaque.lost_to["reason"]
     assert opaque.reason.startswith("not taken in round 1: lost to window_solar_gains")
     assert window.runner_up == {"effect": "opaque_solar_gains", "reason": opaque.lost_to["reason"]}
+
+
+def test_a_finding_the_training_half_pays_for_beats_one_the_season_pays_for():
+    """Held-out blocks fit more data than a rolling fold: the two findings' fold evidence is
+    unlike, and the one the training half's BIC pays for is taken first; the other is judged
+    again in a later round, from the model that has it."""
+    season = _finding("sky_radiation", True, short_of_bic=True)
+    season.evidence = _evidence([1, 1, 1], [0.3, 0.3, 0.3])  # far better on its own folds
+    paid = _finding("wind_infiltration", True, evidence=_evidence([1, 1, 1], [0.8, 0.8, 0.8]))
+    assert _winner([season, paid], 2) is paid
+    assert not season.accepted and season.lost_to == {
+        "effect": "wind_infiltration",
+        "reason": "the training half pays for the winner, not for it",
+    }
 
 
 def test_an_implausible_magnitude_rejects_the_finding_with_its_reason():

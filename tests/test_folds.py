@@ -10,12 +10,13 @@ import pytest
 
 from rcengine.dataset import Dataset
 from rcengine.diagnose import selection
-from rcengine.diagnose.fitting import Split, carried_on, split_data, trust_region
+from rcengine.diagnose.fitting import Split, carried_on, fold_splits, split_data, trust_region
 from rcengine.diagnose.folds import (
     Fold,
     FoldEvidence,
     FoldRule,
     head_to_head,
+    held_out_blocks,
     judge_folds,
     rolling_folds,
 )
@@ -49,6 +50,45 @@ def test_folds_cover_the_season_on_local_midnights_across_dst():
         assert (f.test_start.tz_convert(TZ) - f.train_start.tz_convert(TZ)).days == 28
     starts = [f.train_start for f in folds]
     assert starts == sorted(starts) and len(set(starts)) == 6
+
+
+def test_a_held_out_block_trains_on_the_season_around_its_test_window():
+    """The same test windows; each fit on every row but its window and the guard days after it,
+    so the autumn and the spring both constrain the parameters it is judged with."""
+    times = _season()
+    rolling = rolling_folds(times, TZ, 28, 14, 6)
+    blocks = held_out_blocks(rolling, times, guard_days=2)
+    assert [(b.test_start, b.test_end) for b in blocks] == [
+        (f.test_start, f.test_end) for f in rolling
+    ]
+    for block in blocks:
+        trained = times[block.in_training(times)]
+        assert trained[0] == times[0]
+        assert trained[-1] == times[-1] or block.resume > times[-1]  # the last window ends it
+        assert not ((trained >= block.test_start) & (trained < block.resume)).any()
+        assert block.resume - block.test_end == 2 * DAY
+        assert len(trained) > len(times) - 17 * 48
+    # A rolling fold trains on its four weeks alone.
+    assert rolling[2].in_training(times).sum() == 28 * 48
+
+
+def test_a_held_out_block_s_test_is_carried_on_from_the_rows_before_it():
+    """Training resumes after the window; the test is still forecast from the state the rows
+    just before it give, not restarted on its own measurements."""
+    frame = weather_and_gains(21)
+    frame["t_in"] = basic_reference(frame, TRUTH_BASIC, (14.0, 20.0, 23.0))
+    network = get_model("basic", BUILDING, frame.columns)
+    block = held_out_blocks(
+        rolling_folds(frame.index, BUILDING.location.timezone, 7, 4, 1), frame.index, guard_days=1
+    )[0]
+    (split,) = fold_splits(frame, BUILDING, network, SignalOptions(), [block])
+    assert len(split.train.segments) == 2
+    compiled = network.compile()
+    simulated = carried_on(compiled, TRUTH_BASIC, split)
+    assert np.max(np.abs(simulated - split.test.measured)) < 0.02
+    shifted = split.test.frame.assign(t_in=split.test.measured + 3.0)
+    moved = Split(split.train, Dataset(shifted, split.test.step_s))
+    assert np.array_equal(carried_on(compiled, TRUTH_BASIC, moved), simulated)
 
 
 def test_short_record_gives_fewer_or_no_folds():

@@ -57,7 +57,7 @@ def fold_splits(
     """The record prepared once for the network and cut at every fold's boundaries."""
     data = prepare(frame, building, network.compile().input_names, options)
     return [
-        Split(data.between(f.train_start, f.test_start), data.between(f.test_start, f.test_end))
+        Split(data.where(f.in_training(data.times)), data.between(f.test_start, f.test_end))
         for f in folds
     ]
 
@@ -178,7 +178,11 @@ def carried_on(compiled: CompiledNetwork, params: dict[str, float], split: Split
     segment, no state to carry across) are still restarted that way, from their own rows.
     """
     train, test = split.train, split.test
-    last, first = train.segments[-1], test.segments[0]
+    first = test.segments[0]
+    # The training run that ends where the test begins (a held-out block's training resumes
+    # after it too).
+    before = [seg for seg in train.segments if train.times[seg.stop - 1] < test.times[0]]
+    last = before[-1] if before else train.segments[-1]
     carried = np.full(len(test), np.nan)
     y_last = train.measured[last]
     adjoining = test.times[0] - train.times[last.stop - 1] == pd.Timedelta(seconds=train.step_s)

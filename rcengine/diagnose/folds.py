@@ -19,12 +19,21 @@ from scipy.stats import binom
 
 @dataclass(frozen=True)
 class Fold:
-    """One origin: fit on [train_start, test_start), score on [test_start, test_end). UTC."""
+    """One origin: fit on [train_start, test_start) — and, where ``resume`` is set, on
+    [resume, end of record) too — and score on [test_start, test_end). UTC."""
 
     index: int
     train_start: pd.Timestamp
     test_start: pd.Timestamp
     test_end: pd.Timestamp
+    resume: pd.Timestamp | None = None
+
+    def in_training(self, times: pd.DatetimeIndex) -> np.ndarray:
+        """Which of ``times`` the fold trains on."""
+        before = (times >= self.train_start) & (times < self.test_start)
+        if self.resume is None:
+            return np.asarray(before)
+        return np.asarray(before | (times >= self.resume))
 
     def label(self, timezone: str) -> str:
         """``"2017-01-09…2017-01-22"``: the test window's local dates."""
@@ -75,6 +84,24 @@ def rolling_folds(
             _local_midnight(first, int(o) + span),
         )
         for k, o in enumerate(offsets)
+    ]
+
+
+def held_out_blocks(folds: list[Fold], times: pd.DatetimeIndex, guard_days: int = 2) -> list[Fold]:
+    """The same test windows, each fitted on the whole record but that window and the
+    ``guard_days`` after it (hv-block cross-validation, Racine 2000; Bergmeir & Benítez 2012).
+
+    Four weeks before a window cannot tell a gain that is there all season from a heat-loss
+    coefficient a month's weather leaves free, nor a facade's sun from the horizontal sun while
+    the sun's path barely moves: refitted on its own month, the base model takes either. Fitted
+    on the season around the window, it must carry the same parameters through autumn and
+    spring, as the physics it lacks must too. The guard keeps the days that follow a window,
+    whose slow states still hold its heat, out of the fit that is judged on it.
+    """
+    start = times[0]
+    return [
+        Fold(f.index, start, f.test_start, f.test_end, f.test_end + pd.Timedelta(days=guard_days))
+        for f in folds
     ]
 
 

@@ -76,6 +76,7 @@ class Finding:
     screen: Screen | None = None
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
+    short_of_bic: bool = False
 
     @property
     def improvement_k(self) -> float:
@@ -109,6 +110,10 @@ class Finding:
         }
 
 
+def _test_change(before: float, after: float) -> str:
+    return f"test RMSE {before:.3f} → {after:.3f} K ({(after - before) / before:+.0%})"
+
+
 def judge(
     ext: Extension,
     current: Fit,
@@ -129,13 +134,14 @@ def judge(
     checks = [
         (
             gain >= settings.min_improvement * before and gain >= settings.min_improvement_k,
-            f"test RMSE {before:.3f} → {after:.3f} K ({-gain / before:+.0%})",
+            _test_change(before, after),
         ),
         (delta_bic <= -settings.bic_margin, f"ΔBIC {delta_bic:+.1f}"),
         (not idle, "fitted gain is zero" if idle else "fitted gain is non-zero"),
     ]
     accepted = all(ok for ok, _ in checks)
     failed = [text for ok, text in checks if not ok]
+    short_of_bic = not accepted and failed == [checks[1][1]]
     reason = (
         "accepted: " + "; ".join(text for _, text in checks)
         if accepted
@@ -167,6 +173,7 @@ def judge(
         reason=reason,
         detail=detail,
         fit=fit,
+        short_of_bic=short_of_bic,
     )
 
 
@@ -184,12 +191,28 @@ def confirm_on_folds(
     folds: list[Fold],
     settings: DiagnoseSettings,
     timezone: str,
+    season_bic: float = 0.0,
 ) -> None:
     """Keep a finding that passed the single split accepted only if it also helps in most folds
-    and on their pooled test; the fold evidence goes into the finding either way."""
-    ok, text = judge_folds(evidence, settings.fold_rule)
+    and on their pooled test; the fold evidence goes into the finding either way.
+
+    A finding short of the BIC alone (``short_of_bic``) is judged so too where ``season_bic``,
+    its ΔBIC on the folds' fits over the season around each test window, is within the margin."""
     finding.evidence = evidence
     finding.folds = evidence.to_dict(folds, timezone)
+    if finding.short_of_bic:
+        finding.detail["season_delta_bic"] = season_bic
+        season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
+        if season_bic > -settings.bic_margin:
+            finding.reason += f", {season}"
+            return
+        finding.accepted = True
+        finding.reason = (
+            f"accepted: {_test_change(finding.rmse_test_before, finding.rmse_test_after)}; "
+            f"ΔBIC {finding.delta_bic:+.1f} on the training half, {season}; "
+            "fitted gain is non-zero"
+        )
+    ok, text = judge_folds(evidence, settings.fold_rule)
     single = finding.reason.removeprefix("accepted: ")
     finding.accepted = ok
     finding.reason = (
@@ -205,6 +228,7 @@ def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: 
     if not problems:
         return
     text = "implausible: " + "; ".join(problems)
+    finding.short_of_bic = False
     finding.reason = f"rejected as {text}" if finding.accepted else f"{finding.reason}; {text}"
     finding.accepted = False
 

@@ -28,8 +28,9 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+import numpy as np
 import pandas as pd
 
 from rcengine.building import Building
@@ -45,7 +46,12 @@ from rcengine.diagnose.declared import (
     with_declared_glazing,
 )
 from rcengine.diagnose.excess_sun import EFFECT as EXCESS_SUN_EFFECT
-from rcengine.diagnose.excess_sun import RIVAL_ONLY, attribute_excess_sun
+from rcengine.diagnose.excess_sun import (
+    EXCESS_EFFECTS,
+    RIVAL_ONLY,
+    attribute_excess_sun,
+    sun_as_glazing_g,
+)
 from rcengine.diagnose.fitting import (
     Fit,
     FitJob,
@@ -60,6 +66,7 @@ from rcengine.diagnose.folds import (
     Fold,
     FoldEvidence,
     head_to_head,
+    held_out_blocks,
     judge_folds,
     rolling_folds,
 )
@@ -86,6 +93,7 @@ from rcengine.diagnose.screen import Screen, screen
 from rcengine.diagnose.settings import DiagnoseSettings, split_time
 from rcengine.diagnose.whiteness import ljung_box
 from rcengine.models import get_model
+from rcengine.models.bounds import G_GLAZING_MAX
 from rcengine.network import RCNetwork
 from rcengine.parallel import one_blas_thread
 from rcengine.record import check_diagnosable
@@ -129,6 +137,7 @@ class Selection:
     verdicts: dict[str, Finding] = field(default_factory=dict)
     skipped: dict[str, str] = field(default_factory=dict)
     current_folds: list[Fit] | None = None
+    current_blocks: list[Fit] | None = None
     repair: dict | None = None
 
     def take(self, finding: Finding) -> None:
@@ -138,6 +147,7 @@ class Selection:
         self.accepted.append(finding)
         self.current = finding.fit
         self.current_folds = None
+        self.current_blocks = None
 
     def findings(self, pattern: str) -> list[Finding]:
         """Accepted first, then the rest with the refitted and most helpful ahead, each with its
@@ -248,7 +258,7 @@ def _informative(frame: pd.DataFrame, folds: list[Fold]) -> tuple[list[Fold], li
     q = frame[Q_HVAC].abs()
     kept, left_out = [], []
     for fold in folds:
-        train = q[(q.index >= fold.train_start) & (q.index < fold.test_start)].mean()
+        train = q[fold.in_training(q.index)].mean()
         test = q[(q.index >= fold.test_start) & (q.index < fold.test_end)].mean()
         (left_out if train < MIN_HVAC_SHARE * test else kept).append(fold)
     return kept, left_out
@@ -469,7 +479,7 @@ def _settle_sun(problem: Problem, state: Selection, finding: Finding) -> None:
         )
         finding.absent = {**finding.absent, G_WINDOW_ADDED_MASS: 0.0}
         finding.detail["glazing_g_on_storage"] = fit.params[G_WINDOW_ADDED_MASS]
-        state.current, state.current_folds = fit, None
+        state.current, state.current_folds, state.current_blocks = fit, None, None
 
 
 def _extensions(problem: Problem, state: Selection) -> list[Extension]:
@@ -692,7 +702,11 @@ def _confirm_on_folds(
     """Refit the current model and every extension that passed the single split on each fold
     (warm-started from their fits on the whole training period, in one parallel batch) and keep
     only those that help across the folds (``confirm_on_folds``)."""
-    passing = [(e, f) for e, f in zip(extensions, findings, strict=True) if f.accepted]
+    pairs = list(zip(extensions, findings, strict=True))
+    if problem.settings.fold_training == "hybrid":
+        _confirm_over_the_season(problem, state, [(e, f) for e, f in pairs if f.short_of_bic])
+    # Those judged over the season keep that evidence: the rolling folds are not asked again.
+    passing = [(e, f) for e, f in pairs if f.accepted and not f.short_of_bic]
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
@@ -711,6 +725,64 @@ def _confirm_on_folds(
             problem.settings,
             problem.building.location.timezone,
         )
+
+
+def _confirm_over_the_season(
+    problem: Problem, state: Selection, short: list[tuple[Extension, Finding]]
+) -> None:
+    """Findings short of the training half's BIC alone, judged on held-out blocks."""
+    short = _not_the_excess_sun(short, sun_as_glazing_g(state.current))
+    if not short:
+        return
+    blocks = held_out_blocks(problem.folds, problem.frame.index)
+    seasonal = replace(problem, folds=blocks)
+    if state.current_blocks is None:
+        current = state.current
+        (state.current_blocks,) = _fold_fits(
+            seasonal, [(current.network, current.options, current.params)]
+        )
+    fits = _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in short])
+    before = tuple(f.residual_test for f in state.current_blocks)
+    for (_, finding), fold_fits in zip(short, fits, strict=True):
+        confirm_on_folds(
+            finding,
+            FoldEvidence(before, tuple(f.residual_test for f in fold_fits)),
+            blocks,
+            problem.settings,
+            problem.building.location.timezone,
+            _season_bic(state.current_blocks, fold_fits),
+        )
+
+
+def _not_the_excess_sun(
+    short: list[tuple[Extension, Finding]], g: float | None
+) -> list[tuple[Extension, Finding]]:
+    """``short`` but the ways the sun comes in, where the model already lets in more than glass
+    could (``g``, its sun as the declared glazing's g-value): which way carries that excess is
+    the excess-sun step's to judge, with the sun held to glass, after the selection; the season's
+    evidence is no ground to pick one before it. Those left out are rejected with why."""
+    if g is None or g <= G_GLAZING_MAX:
+        return short
+    for _, finding in (p for p in short if p[1].effect in EXCESS_EFFECTS):
+        finding.short_of_bic = False
+        finding.reason += (
+            f"; the model's sun is already beyond glass (as g = {g:.2f}): the excess-sun step "
+            "judges which way it comes in"
+        )
+    return [p for p in short if p[1].short_of_bic]
+
+
+def _season_bic(current: list[Fit], extended: list[Fit]) -> float:
+    """The median over the folds of the extension's ΔBIC on its fold's training rows.
+
+    A held-out block's fit spans the season around its window: the autumn's low sun and the
+    spring's high, the cold months and the mild, where the training half has three months of
+    one. Effects that only the sun's course or the weather's range identify — a facade's own
+    g-value, a sky the heat-loss coefficient stands in for while it is cold — pay for their
+    parameters there or nowhere."""
+    return float(
+        np.median([e.criteria_change(c)["bic"] for c, e in zip(current, extended, strict=True)])
+    )
 
 
 def _fold_fits_beside_current(
@@ -904,6 +976,10 @@ def _winner(confirmed: list[Finding], round_no: int) -> Finding | None:
 
 def _duel(first: Finding, second: Finding) -> tuple[int, str]:
     """Which of two passing findings explains more (0 or 1), and why the other lost."""
+    if first.short_of_bic != second.short_of_bic:
+        # Judged on unlike folds (held-out blocks fit more data): the one the training half
+        # pays for comes first, the season's on its own evidence in a later round.
+        return int(first.short_of_bic), "the training half pays for the winner, not for it"
     if first.evidence is not None and second.evidence is not None:
         return head_to_head(first.evidence, second.evidence)
     winner = 0 if first.improvement_k >= second.improvement_k else 1

@@ -32,32 +32,35 @@ FOLD_REFIT = EstimatorSettings(
 @dataclass(frozen=True)
 class DiagnoseSettings:
     """train_fraction: share of the record (whole days) used for fitting, the rest is the test;
-    preset: estimator preset of the baseline and of every refit that adds inputs;
-    structural_preset: of refits that add a state (a new capacitor brings new basins, which the
-    longer GA of "default" explores); confirm: candidates refitted per round after the first
-    (which refits them all), the most promising by their earlier refit and screen (default: all
-    of them; fewer trades a pair's second effect for speed); min_improvement: relative test-RMSE
-    cut an extension must bring, and min_improvement_k in kelvin (0.1 K, a room sensor's
-    accuracy: smaller gains are no evidence of physics); bic_margin: how much the effective-n
-    BIC must drop; max_rounds: forward-selection rounds; baseline_starts: independent searches
-    for the baseline fit (best kept); workers: processes for the refits of a round (default:
-    every core); effects: the candidate ids to consider (default: the whole vocabulary); bounds:
-    the base model's parameter bounds, "building" (derived from its description) or "thesis"
-    (Table 2.3); evidence: "folds" confirms an extension that passes the single split on rolling
-    folds across the record (fold_train_days of training, the next fold_test_days tested, up to
-    max_folds origins, each refitted with fold_preset from the fit on the training half;
-    accepted when it helps in more than min_fold_share of them and cuts the pooled test RMSE by
-    min_improvement; the kelvin margin is the single split's alone, see ``folds.FoldRule``),
-    "split" judges on the single split alone; min_step_s: the finest step judged [s] — a finer
-    record is averaged into intervals of at least this (``dataset.aggregated``): the physics of
-    the vocabulary acts over hours (the sun's course, schedules, the mass's and an emitter's
-    hours-long time constants), and a six-month record at a logger's 5 minutes took 74 s to
-    judge against 18 s at 30 minutes; excess_sun: a model with declared glazing has the opaque
-    sun judged on its own once the selection has ended, from sun its apertures admit beyond what
-    the declared glazing could as glass, against undeclared glazing (``excess_sun``), and in the
-    selection's rounds only as a rival to an effect that passes;
-    clock_check: the building's summer-time readings are re-aligned by an hour where the base
-    model fits the weather clearly better so (a logger on standard time all year, ``clock``)."""
+    preset: estimator preset of the baseline and of every refit that adds inputs; structural_preset:
+    of refits that add a state (a new capacitor brings new basins, which the longer GA of "default"
+    explores); confirm: candidates refitted per round after the first (which refits them all), the
+    most promising by their earlier refit and screen (default: all of them; fewer trades a pair's
+    second effect for speed); min_improvement: relative test-RMSE cut an extension must bring, and
+    min_improvement_k in kelvin (0.1 K, a room sensor's accuracy: smaller gains are no evidence of
+    physics); bic_margin: how much the effective-n BIC must drop; max_rounds: forward-selection
+    rounds; baseline_starts: independent searches for the baseline fit (best kept); workers:
+    processes for the refits of a round (default: every core); effects: the candidate ids to
+    consider (default: the whole vocabulary); bounds: the base model's parameter bounds, "building"
+    (derived from its description) or "thesis" (Table 2.3); evidence: "folds" confirms an extension
+    that passes the single split on rolling folds across the record (fold_train_days of training,
+    the next fold_test_days tested, up to max_folds origins, each refitted with fold_preset from the
+    fit on the training half; accepted when it helps in more than min_fold_share of them and cuts
+    the pooled test RMSE by min_improvement; the kelvin margin is the single split's alone, see
+    ``folds.FoldRule``), "split" judges on the single split alone; fold_training: "hybrid" judges a
+    candidate that passes every check of the single split but the BIC on held-out blocks instead —
+    the same test windows, each fold fitted on the whole record but its window and two guard days
+    after it (``folds.held_out_blocks``) — accepted where the median of its ΔBIC over those fits is
+    within bic_margin and the fold rule holds on them; "rolling" rejects it; min_step_s: the finest
+    step judged [s] — a finer record is averaged into intervals of at least this
+    (``dataset.aggregated``): the physics of the vocabulary acts over hours (the sun's course,
+    schedules, the mass's and an emitter's hours-long time constants), and a six-month record at a
+    logger's 5 minutes took 74 s to judge against 18 s at 30 minutes; excess_sun: a model with
+    declared glazing has the opaque sun judged on its own once the selection has ended, from sun its
+    apertures admit beyond what the declared glazing could as glass, against undeclared glazing
+    (``excess_sun``), and in the selection's rounds only as a rival to an effect that passes;
+    clock_check: the building's summer-time readings are re-aligned by an hour where the base model
+    fits the weather clearly better so (a logger on standard time all year, ``clock``)."""
 
     train_fraction: float = 0.5
     preset: str = "study"
@@ -77,6 +80,7 @@ class DiagnoseSettings:
     fold_test_days: int = 14
     max_folds: int = 6
     fold_preset: str | EstimatorSettings = FOLD_REFIT
+    fold_training: Literal["rolling", "hybrid"] = "hybrid"
     min_fold_share: float = 0.5
     min_step_s: float = 900.0
     excess_sun: bool = True
