@@ -13,8 +13,14 @@ import pytest
 from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.folds import FoldEvidence, rolling_folds
 from rcengine.diagnose.health import Health
-from rcengine.diagnose.html import _residual_before, render
-from rcengine.diagnose.report import Finding, confirm_on_folds, reject_implausible, verdict
+from rcengine.diagnose.html import _fold_tables, _residual_before, render
+from rcengine.diagnose.report import (
+    Finding,
+    _across,
+    confirm_on_folds,
+    reject_implausible,
+    verdict,
+)
 from rcengine.diagnose.selection import (
     MIN_HVAC_SHARE,
     _informative,
@@ -148,7 +154,11 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
         "accepted: test RMSE 1.000 → 0.500 K (-50%); ΔBIC +9.1 on the training half, -21.8 over "
         "the season"
     )
-    assert "across folds: helps in 3 of 3 folds" in paid.reason
+    assert "across held-out blocks: helps in 3 of 3 folds" in paid.reason
+    assert paid.folds["training"] == "held-out blocks"
+    assert _across(paid).startswith("; across 3 held-out blocks it helps in 3")
+    table = _fold_tables({"effect": "window_solar_gains", "folds": paid.folds})
+    assert "window_solar_gains across held-out blocks: helps in 3" in table
     unpaid = short(-4.0)
     assert not unpaid.accepted and unpaid.reason == (
         "rejected: ΔBIC +9.1, -4.0 over the season (median of the folds' fits)"

@@ -171,8 +171,9 @@ def _health_box(d: dict) -> str:
 
 def _fold_tables(finding: dict) -> str:
     """A finding's fold evidence when it was judged, and its backward check's when it had one."""
-    effect = finding["effect"]
-    return _folds_table(f"{effect} across rolling folds", finding["folds"]) + _folds_table(
+    effect, folds = finding["effect"], finding["folds"]
+    across = (folds or {}).get("training", "rolling folds")
+    return _folds_table(f"{effect} across {across}", folds) + _folds_table(
         f"{effect} added last, to the other findings (backward check)", finding.get("backward")
     )
 

@@ -110,6 +110,11 @@ class Finding:
         }
 
 
+# How a finding judged over the season was refitted, in its report's ``folds`` (``training``):
+# each fold on the whole record but its test window and guard days (``folds.held_out_blocks``).
+HELD_OUT_BLOCKS = "held-out blocks"
+
+
 def _test_change(before: float, after: float) -> str:
     return f"test RMSE {before:.3f} → {after:.3f} K ({(after - before) / before:+.0%})"
 
@@ -200,7 +205,9 @@ def confirm_on_folds(
     its ΔBIC on the folds' fits over the season around each test window, is within the margin."""
     finding.evidence = evidence
     finding.folds = evidence.to_dict(folds, timezone)
+    across = "folds"
     if finding.short_of_bic:
+        across = finding.folds["training"] = HELD_OUT_BLOCKS
         finding.detail["season_delta_bic"] = season_bic
         season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
         if season_bic > -settings.bic_margin:
@@ -216,9 +223,9 @@ def confirm_on_folds(
     single = finding.reason.removeprefix("accepted: ")
     finding.accepted = ok
     finding.reason = (
-        f"accepted: {single}; across folds: {text}"
+        f"accepted: {single}; across {across}: {text}"
         if ok
-        else f"rejected across folds: {text} (single split: {single})"
+        else f"rejected across {across}: {text} (single split: {single})"
     )
 
 
@@ -313,8 +320,9 @@ def _across(finding: Finding) -> str:
         return ""
     n, ties = len(finding.folds["folds"]), finding.folds["tied"]
     tied = f", {ties} tied" if ties else ""
+    folds = finding.folds.get("training", "rolling folds")
     return (
-        f"; across {n} rolling folds it helps in {finding.folds['helped']}{tied} "
+        f"; across {n} {folds} it helps in {finding.folds['helped']}{tied} "
         f"(pooled test RMSE {finding.folds['pooled_rmse_test_before']:.2f} → "
         f"{finding.folds['pooled_rmse_test_after']:.2f} K)"
     )
