@@ -145,9 +145,12 @@ class Selection:
         it is accepted, not a verdict)."""
         self.verdicts.pop(finding.effect, None)
         self.accepted.append(finding)
-        self.current = finding.fit
-        self.current_folds = None
-        self.current_blocks = None
+        self.go_on_from(finding.fit)
+
+    def go_on_from(self, fit: Fit, fold_fits: list[Fit] | None = None) -> None:
+        """Continue from ``fit`` (and its rolling folds' fits where known); the fits judged
+        against the model before it are no longer its own."""
+        self.current, self.current_folds, self.current_blocks = fit, fold_fits, None
 
     def findings(self, pattern: str) -> list[Finding]:
         """Accepted first, then the rest with the refitted and most helpful ahead, each with its
@@ -479,7 +482,7 @@ def _settle_sun(problem: Problem, state: Selection, finding: Finding) -> None:
         )
         finding.absent = {**finding.absent, G_WINDOW_ADDED_MASS: 0.0}
         finding.detail["glazing_g_on_storage"] = fit.params[G_WINDOW_ADDED_MASS]
-        state.current, state.current_folds, state.current_blocks = fit, None, None
+        state.go_on_from(fit)
 
 
 def _extensions(problem: Problem, state: Selection) -> list[Extension]:
@@ -866,7 +869,7 @@ def _backward(problem: Problem, state: Selection) -> None:
         dropped.reason = f"dropped by the backward check: {dropped.backward['reason']}"
         state.accepted.remove(dropped)
         state.verdicts[dropped.effect] = dropped
-        state.current, state.current_folds = reduced[judged.index(dropped)]
+        state.go_on_from(*reduced[judged.index(dropped)])
 
 
 def _recheck_repair(problem: Problem, state: Selection) -> None:
@@ -909,7 +912,7 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
         f"dropped once the later findings were in: without it the model is healthy; {text}"
     )
     state.verdicts[repair.effect] = repair
-    state.current, state.current_folds = fit, fold_fits
+    state.go_on_from(fit, fold_fits)
 
 
 def _added_last(problem: Problem, evidence: FoldEvidence, text: str, **verdict: bool) -> dict:
