@@ -18,6 +18,7 @@ from rcengine.diagnose.report import (
     Finding,
     _across,
     confirm_on_folds,
+    confirm_over_the_season,
     reject_implausible,
     verdict,
 )
@@ -145,7 +146,9 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
             "window_solar_gains", False, reason="rejected: ΔBIC +9.1", short_of_bic=True
         )
         finding.delta_bic = 9.1
-        confirm_on_folds(finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic)
+        confirm_over_the_season(
+            finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic
+        )
         return finding
 
     paid = short(-21.8)

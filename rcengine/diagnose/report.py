@@ -196,37 +196,58 @@ def confirm_on_folds(
     folds: list[Fold],
     settings: DiagnoseSettings,
     timezone: str,
-    season_bic: float = 0.0,
+    training: str | None = None,
 ) -> None:
     """Keep a finding that passed the single split accepted only if it also helps in most folds
-    and on their pooled test; the fold evidence goes into the finding either way.
-
-    A finding short of the BIC alone (``short_of_bic``) is judged so too where ``season_bic``,
-    its ΔBIC on the folds' fits over the season around each test window, is within the margin."""
-    finding.evidence = evidence
-    finding.folds = evidence.to_dict(folds, timezone)
-    across = "folds"
-    if finding.short_of_bic:
-        across = finding.folds["training"] = HELD_OUT_BLOCKS
-        finding.detail["season_delta_bic"] = season_bic
-        season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
-        if season_bic > -settings.bic_margin:
-            finding.reason += f", {season}"
-            return
-        finding.accepted = True
-        finding.reason = (
-            f"accepted: {_test_change(finding.rmse_test_before, finding.rmse_test_after)}; "
-            f"ΔBIC {finding.delta_bic:+.1f} on the training half, {season}; "
-            "fitted gain is non-zero"
-        )
+    and on their pooled test; the fold evidence goes into the finding either way (``training``:
+    how the folds were fitted, where not the rolling folds')."""
+    _record(finding, evidence, folds, timezone, training)
     ok, text = judge_folds(evidence, settings.fold_rule)
     single = finding.reason.removeprefix("accepted: ")
+    across = training or "folds"
     finding.accepted = ok
     finding.reason = (
         f"accepted: {single}; across {across}: {text}"
         if ok
         else f"rejected across {across}: {text} (single split: {single})"
     )
+
+
+def confirm_over_the_season(
+    finding: Finding,
+    evidence: FoldEvidence,
+    blocks: list[Fold],
+    settings: DiagnoseSettings,
+    timezone: str,
+    season_bic: float,
+) -> None:
+    """A finding short of the training half's BIC alone (``short_of_bic``), judged on held-out
+    blocks: it passes the BIC where ``season_bic``, its ΔBIC on the blocks' fits over the season
+    around each test window, is within the margin, and is then judged as ``confirm_on_folds``."""
+    finding.detail["season_delta_bic"] = season_bic
+    season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
+    if season_bic > -settings.bic_margin:
+        _record(finding, evidence, blocks, timezone, HELD_OUT_BLOCKS)
+        finding.reason += f", {season}"
+        return
+    finding.reason = (
+        f"accepted: {_test_change(finding.rmse_test_before, finding.rmse_test_after)}; "
+        f"ΔBIC {finding.delta_bic:+.1f} on the training half, {season}; fitted gain is non-zero"
+    )
+    confirm_on_folds(finding, evidence, blocks, settings, timezone, HELD_OUT_BLOCKS)
+
+
+def _record(
+    finding: Finding,
+    evidence: FoldEvidence,
+    folds: list[Fold],
+    timezone: str,
+    training: str | None,
+) -> None:
+    finding.evidence = evidence
+    finding.folds = evidence.to_dict(folds, timezone)
+    if training is not None:
+        finding.folds["training"] = training
 
 
 def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: list[str]) -> None:

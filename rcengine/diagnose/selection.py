@@ -84,6 +84,7 @@ from rcengine.diagnose.report import (
     Finding,
     Report,
     confirm_on_folds,
+    confirm_over_the_season,
     explain,
     judge,
     reject_implausible,
@@ -747,7 +748,7 @@ def _confirm_over_the_season(
     fits = _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in short])
     before = tuple(f.residual_test for f in state.current_blocks)
     for (_, finding), fold_fits in zip(short, fits, strict=True):
-        confirm_on_folds(
+        confirm_over_the_season(
             finding,
             FoldEvidence(before, tuple(f.residual_test for f in fold_fits)),
             blocks,
