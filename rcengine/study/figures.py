@@ -105,7 +105,9 @@ def example(
     err = np.sqrt(np.nanmean((measured - predicted) ** 2))
     ax.set_title(f"{title} (RMSE {err:.2f} °C)")
     ax.set_ylabel("indoor temperature [°C]")
-    ax.legend()
+    # Beside the axes, not loc="best": searching a week of quarter-hours for the emptiest corner
+    # is slow (matplotlib warns), and no corner of a temperature trace stays empty anyway.
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.autofmt_xdate()
     return _save(fig, path)
 
