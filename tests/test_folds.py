@@ -503,16 +503,17 @@ def test_the_soil_s_lag_is_the_version_the_evidence_takes():
 
 def test_every_ground_version_not_taken_is_named():
     """Four versions (two lags, each with and without the layer of soil): the one taken names
-    the three others, whichever order they were judged in."""
-    lags = ((1.0, None, 0.8), (1.5, None, 0.7), (1.0, 0.25, 0.5), (1.5, 0.25, 0.6))
+    the three others, whichever order they were judged in, a layered one with its fitted depth."""
+    lags = ((1.0, None, 0.8), (1.5, None, 0.7), (1.0, 0.5, 0.5), (1.5, 1.2, 0.6))
     versions = []
-    for lag, layer, pooled in lags:
+    for lag, depth, pooled in lags:
         version = _version("ground_coupling", "", 1.0, pooled)
-        version.detail = {"ground_lag_months": lag, "soil_layer_r_m2k_w": layer}
+        version.detail = {"ground_lag_months": lag, "soil_layer": depth is not None}
+        version.fit.params = {"d_soil": depth}
         versions.append(version)
     assert _one_version_each(versions) == [versions[2]]
     assert versions[2].detail["ground_lag_not_taken"].split("; ") == [
         "1.0 months (0.800 K pooled over the folds)",
         "1.5 months (0.700 K pooled over the folds)",
-        "1.5 months through the layer of soil (0.600 K pooled over the folds)",
+        "1.5 months through 1.2 m of soil (0.600 K pooled over the folds)",
     ]

@@ -25,7 +25,8 @@ from rcengine.columns import (
 from rcengine.diagnose import candidates
 from rcengine.diagnose.candidates import (
     CANDIDATES,
-    SOIL_LAYER_R,
+    SOIL_LAYER_DEPTH,
+    SOIL_LAYER_DEPTH_ISO,
     Context,
     Extension,
     heater_saturated,
@@ -40,6 +41,7 @@ from rcengine.signals import SignalOptions, prepare
 from rcengine.signals.derived import derive
 from rcengine.signals.ground import (
     ESTIMATE_Z,
+    SOIL_CONDUCTIVITY,
     YEAR_S,
     annual_cycle,
     annual_mean_uncertainty,
@@ -104,14 +106,21 @@ def _window(ext: Extension, g: float) -> dict[str, float]:
     return dict.fromkeys(ext.new_parameters, g)
 
 
-def _ground(ext: Extension, u_floor: float, t_ground: float) -> dict[str, float]:
-    """r_floor and q_ground for a floor U-value and a mean ground temperature (q_ground the
-    ground's warming ΔT over the resistance it is seen through: the layer of soil's, else the
-    floor's)."""
-    seen_through = ext.detail.get("soil_layer_r_m2k_w") or 1 / u_floor
+def _ground(
+    ext: Extension, u_floor: float, t_ground: float, d_soil: float = SOIL_LAYER_DEPTH_ISO
+) -> dict[str, float]:
+    """r_floor, q_ground (and d_soil, for a version with a layer of soil) for a floor U-value
+    and a mean ground temperature (q_ground the ground's warming ΔT over the resistance it is
+    seen through: the layer of soil's, d_soil/λ, else the floor's)."""
+    if not ext.detail["soil_layer"]:
+        return {
+            "r_floor": 1 / u_floor,
+            "q_ground": (t_ground - ext.detail["ground_base_c"]) * u_floor,
+        }
     return {
         "r_floor": 1 / u_floor,
-        "q_ground": (t_ground - ext.detail["ground_base_c"]) / seen_through,
+        "q_ground": (t_ground - ext.detail["ground_base_c"]) * SOIL_CONDUCTIVITY / d_soil,
+        "d_soil": d_soil,
     }
 
 
@@ -268,10 +277,11 @@ def test_implausibly_small_magnitudes_are_rejected_too(gain_context):
 
 def test_a_layered_floor_is_read_through_its_layer_of_soil(gain_context):
     """ISO 13370's U spans the slab and the soil to where the ground temperature is read: the
-    layered version's r_floor plus ISO 52016-1's 0.25 m²K/W of soil. A floor of 5 W/(m²K) above
-    the layer is 2.2 through it, within an uninsulated slab's; one of 30 is 3.3 and exceeds it."""
+    layered version's r_floor plus its soil's (0.25 m²K/W at ISO 52016-1's 0.5 m). A floor of
+    5 W/(m²K) above the layer is 2.2 through it, within an uninsulated slab's; one of 30 is 3.3
+    and exceeds it."""
     ground = CANDIDATES["ground_coupling"](gain_context)
-    (layered, *_) = [e for e in ground.alternatives if e.detail["soil_layer_r_m2k_w"]]
+    (layered, *_) = [e for e in ground.alternatives if e.detail["soil_layer"]]
     soil = _between(layered)
     for u_above, readback, plausible in ((5.0, 1 / 0.45, True), (30.0, 1 / (1 / 30 + 0.25), False)):
         assessment = assess(layered, {**TRUTH_BASIC, **_ground(layered, u_above, soil)})
@@ -482,8 +492,9 @@ def test_the_ground_candidate_reads_the_soil_at_both_ends_of_iso_13370_s_lags(ga
     assert deeper.detail["ground_lag_months"] == pytest.approx(1.5)
     for version, lag_of in ((layered, ground), (layered_deeper, deeper)):
         assert version.signals == lag_of.signals
-        assert version.detail["soil_layer_r_m2k_w"] == SOIL_LAYER_R
-    assert ground.detail["soil_layer_r_m2k_w"] is None
+        assert version.detail["soil_layer"]
+        assert version.new_parameters == (*ground.new_parameters, "d_soil")
+    assert not ground.detail["soil_layer"]
     assert deeper.new_parameters == ground.new_parameters and not deeper.alternatives
     times, t_out = gain_context.data.times, gain_context.train["t_out"].to_numpy(dtype=float)
     for version in (ground, deeper):
@@ -491,38 +502,45 @@ def test_the_ground_candidate_reads_the_soil_at_both_ends_of_iso_13370_s_lags(ga
         assert version.detail["ground_base_c"] == pytest.approx(np.mean(soil))
 
 
-def test_the_layer_of_soil_is_iso_52016_s_under_the_footprint(gain_context):
-    """0.5 m of soil (λ 2.0 W/(mK), ρc 2.0 MJ/(m³K)) per m² of the footprint between the soil
-    read and the floor, r_floor from the layer to the interior mass."""
+def test_the_layer_of_soil_is_fitted_in_depth_from_iso_52016_s(gain_context):
+    """d_soil of soil (λ 2.0 W/(mK), ρc 2.0 MJ/(m³K)) per m² of the footprint between the soil
+    read and the floor: C = ρc·d·A and R = d/(λ·A), both on the one fitted depth, searched from
+    0.1 to 2 m and started at ISO 52016-1's 0.5 m, where it is the old fixed layer (1 MJ/(m²K),
+    0.25 m²K/W); r_floor from the layer to the interior mass."""
     (layered,) = [
         v
         for v in CANDIDATES["ground_coupling"](gain_context).alternatives
-        if v.detail["soil_layer_r_m2k_w"] and v.detail["ground_lag_months"] == pytest.approx(1.0)
+        if v.detail["soil_layer"] and v.detail["ground_lag_months"] == pytest.approx(1.0)
     ]
     net, footprint = layered.network, SMALL.footprint_area
     (soil,) = [c for c in net.capacitors if c.node == "soil"]
-    assert soil.capacity * soil.factor == pytest.approx(1.0e6 * footprint)
+    assert soil.capacity == "d_soil"
+    assert SOIL_LAYER_DEPTH_ISO * soil.factor == pytest.approx(1.0e6 * footprint)
     (layer,) = [r for r in net.resistors if {r.a, r.b} == {T_GROUND, "soil"}]
-    assert layer.resistance * layer.factor == pytest.approx(0.25 / footprint)
+    assert layer.resistance == "d_soil"
+    assert SOIL_LAYER_DEPTH_ISO * layer.factor == pytest.approx(0.25 / footprint)
+    depth = net.parameters["d_soil"]
+    assert (depth.lower, depth.upper) == SOIL_LAYER_DEPTH == (0.1, 2.0)
+    assert layered.neutral["d_soil"] == SOIL_LAYER_DEPTH_ISO == 0.5
     (floor,) = [r for r in net.resistors if r.resistance == "r_floor"]
     assert {floor.a, floor.b} == {"soil", "int"}
 
 
-@pytest.mark.parametrize("layer", [False, True])
-def test_the_soil_s_constant_heat_is_a_warmer_ground(gain_context, layer):
+@pytest.mark.parametrize("layer, d_soil", [(False, None), (True, 0.5), (True, 1.2)])
+def test_the_soil_s_constant_heat_is_a_warmer_ground(gain_context, layer, d_soil):
     """The soil's warming by the building enters as the constant heat of its Norton equivalent,
     ΔT/R on the node the ground is seen from (the floor's without the layer, the layer's with
-    it): settled, q_ground raises the room as a ground ΔT = q·R warmer does, and the ground
-    temperature read for plausibility is that one."""
+    it, R = d_soil/λ at any depth): settled, q_ground raises the room as a ground ΔT = q·R
+    warmer does, and the ground temperature read for plausibility is that one."""
     ground = CANDIDATES["ground_coupling"](gain_context)
     (version,) = [
         v
         for v in (ground, *ground.alternatives)
-        if bool(v.detail["soil_layer_r_m2k_w"]) == layer
-        and v.detail["ground_lag_months"] == pytest.approx(1.0)
+        if v.detail["soil_layer"] == layer and v.detail["ground_lag_months"] == pytest.approx(1.0)
     ]
-    params = {**TRUTH_BASIC, **_ground(version, 0.8, version.detail["ground_base_c"] + 3.0)}
-    r = SOIL_LAYER_R if layer else params["r_floor"]
+    warmer = version.detail["ground_base_c"] + 3.0
+    params = {**TRUTH_BASIC, **_ground(version, 0.8, warmer, *([d_soil] if layer else []))}
+    r = d_soil / SOIL_CONDUCTIVITY if layer else params["r_floor"]
     gains = steady_state_gains(version.network, params)
     assert gains[UNIT] == pytest.approx(gains[T_GROUND] * 3.0)
     t_ground = assess(version, params).magnitudes["t_ground"]["value"]

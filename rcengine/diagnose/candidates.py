@@ -72,6 +72,8 @@ from rcengine.signals import SignalOptions
 from rcengine.signals.derived import indoor_operating_point
 from rcengine.signals.ground import (
     GROUND_LAGS_S,
+    SOIL_CONDUCTIVITY,
+    SOIL_HEAT_CAPACITY,
     YEAR_S,
     annual_cycle,
     annual_mean_uncertainty,
@@ -712,10 +714,15 @@ def metered_gains_on_schedule(ctx: Context, on: np.ndarray) -> dict[str, float]:
     return {"metered_w_m2": level} if level > 0.0 else {}
 
 
-# ISO 52016-1's virtual layer of soil between a floor on the ground and the ground temperature:
-# 0.5 m of soil at λ = 2.0 W/(mK) and ρc = 2.0 MJ/(m³K) (ISO 13370's sand or gravel). [m²K/W],
-# [J/(K·m²)]
-SOIL_LAYER_R, SOIL_LAYER_C = 0.5 / 2.0, 0.5 * 2.0e6
+# The layer of soil between a floor on the ground and the soil read, whose storage a heated slab
+# charges over days and gets back through a holiday or a cold snap: ISO 52016-1 takes a virtual
+# layer of 0.5 m (the warm start); its depth is fitted from a bed of fill (0.1 m) to 2 m, about
+# where the annual wave is read (1.66 m at a month's lag, 2.49 m at a month and a half). The soil
+# is ISO 13370's sand or gravel (``SOIL_CONDUCTIVITY``, ``SOIL_HEAT_CAPACITY``): the periodic
+# penetration depth of a month's swing in it, √(λ·P/(π·ρc)), is 0.9 m, so the weeks of a heating
+# season reach about a metre down. [m]
+SOIL_LAYER_DEPTH = (0.1, 2.0)
+SOIL_LAYER_DEPTH_ISO = 0.5
 
 
 def ground_coupling(ctx: Context) -> Extension | Skipped:
@@ -729,12 +736,14 @@ def ground_coupling(ctx: Context) -> Extension | Skipped:
     T_base + q·r.
     The lag depends on the floor's insulation, which the building description does not give:
     the soil is read at the model's lag (a month by default), and at ISO 13370's other lags
-    (``GROUND_LAGS_S``) as alternatives. Each lag is also offered through ISO 52016-1's virtual
-    layer of soil (``SOIL_LAYER_R``, ``SOIL_LAYER_C``) between the floor and the soil read: a
-    heated slab warms the soil under it over days and gets that heat back when the heating
+    (``GROUND_LAGS_S``) as alternatives. Each lag is also offered through a layer of soil between
+    the floor and the soil read, its depth fitted (``SOIL_LAYER_DEPTH``; ISO 52016-1 fixes 0.5 m):
+    a heated slab warms the soil under it over days and gets that heat back when the heating
     stops (a holiday, a cold snap), which a floor straight onto its boundary temperature
     answers at once; without the layer, a storage added to the air (``thermal_mass``) took that
-    part first and the ground was read at a soil colder than any.
+    part first and the ground was read at a soil colder than any. With ISO 52016-1's 0.5 m, a
+    test bed's bare Chicago slab on 1 m of soil (``testbed_sealed_29``) was still read at 3.9 °C,
+    colder than any soil; through its fitted 1.1 m it reads 12.0 °C, U 0.94 W/(m²K).
     """
     effect = "ground_coupling"
     if T_GROUND in ctx.network.signals:
@@ -755,9 +764,9 @@ def _ground_at(
     ctx: Context, signals: SignalOptions, soil: dict[str, float], layer: bool
 ) -> Extension:
     """``ground_coupling`` with the soil read at ``signals.ground_depth_m``, judged against
-    ``soil`` (``_ground_temperatures`` at that depth); with ``layer``, through ISO 52016-1's
-    virtual layer of soil under the floor (``SOIL_LAYER_R``, ``SOIL_LAYER_C``), whose own
-    storage a slab on the ground charges over days and gives back through a holiday."""
+    ``soil`` (``_ground_temperatures`` at that depth); with ``layer``, through a layer of soil
+    d_soil deep under the floor (R = d/λ, C = ρc·d per m² of footprint), whose own storage a slab
+    on the ground charges over days and gives back through a holiday."""
     effect = "ground_coupling"
     net = ctx.network.copy(_name(ctx.network, effect))
     footprint = ctx.building.footprint_area
@@ -765,8 +774,11 @@ def _ground_at(
     # The node the floor reaches the soil at: the soil read, or the layer's own.
     soil_side = "soil" if layer else T_GROUND
     if layer:
-        net.add_capacitor(soil_side, SOIL_LAYER_C, factor=footprint)
-        net.add_resistor(T_GROUND, soil_side, SOIL_LAYER_R, factor=1.0 / footprint)
+        meaning = "depth of the layer of soil under the floor"
+        net.add_parameter(Parameter("d_soil", "m", *SOIL_LAYER_DEPTH, meaning))
+        net.add_capacitor(soil_side, "d_soil", factor=SOIL_HEAT_CAPACITY * footprint)
+        lambda_area = SOIL_CONDUCTIVITY * footprint  # R = d/(λ·A) [W/(m·K)·m²]
+        net.add_resistor(T_GROUND, soil_side, "d_soil", factor=1.0 / lambda_area)
     net.add_parameter(
         Parameter(
             "r_floor",
@@ -790,21 +802,22 @@ def _ground_at(
     # The soil's warming by the building, ΔT on the ground temperature, is the constant heat
     # ΔT/R of its Norton equivalent, on the node the ground temperature is seen from.
     heated = soil_side if layer else target
+    iso_depth = {"d_soil": SOIL_LAYER_DEPTH_ISO} if layer else {}
     net.add_heat_input(UNIT, heated, "q_ground", factor=footprint)
     return Extension(
         effect,
         net,
         signals,
-        ("r_floor", "q_ground"),
+        ("r_floor", "q_ground", *iso_depth),
         ((T_GROUND, heated), (UNIT, heated)),
-        neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0},
-        absent={"r_floor": np.inf, "q_ground": 0.0},
+        neutral={"r_floor": SEARCH_MARGIN / U_FLOOR[0], "q_ground": 0.0, **iso_depth},
+        absent={"r_floor": np.inf, "q_ground": 0.0, **iso_depth},
         detail={
             "node": target,
             "ground_floor_area_m2": footprint,
             "ground_depth_m": signals.ground_depth_m,
             "ground_lag_months": 12.0 * ground_lag(signals.ground_depth_m) / YEAR_S,
-            "soil_layer_r_m2k_w": SOIL_LAYER_R if layer else None,
+            "soil_layer": layer,
             **soil,
         },
     )

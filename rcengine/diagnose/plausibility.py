@@ -38,7 +38,7 @@ from rcengine.models.bounds import (
 )
 from rcengine.models.physical import solar_apertures, steady_state_gains, ua
 from rcengine.signals.film import H_RE, radiative_coefficient
-from rcengine.signals.ground import ESTIMATE_Z
+from rcengine.signals.ground import ESTIMATE_Z, SOIL_CONDUCTIVITY
 
 if TYPE_CHECKING:
     from rcengine.diagnose.candidates import Extension
@@ -329,15 +329,16 @@ def _occupied(detail: Mapping) -> list[Reading]:
 
 
 def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
-    """Floor U-value 1/(r_floor + the layer of soil's R, where the version has one) and the
-    fitted mean ground temperature: the undisturbed soil's T_base raised by q_ground·R (the
-    constant heat q_ground is (T_g − T_base)/R, R the floor's r_floor, or the layer of soil's
-    where the version has one); the lag of the soil it was read at, reported only."""
+    """Floor U-value 1/(r_floor + the layer of soil's R = d_soil/λ, where the version has one)
+    and the fitted mean ground temperature: the undisturbed soil's T_base raised by q_ground·R
+    (the constant heat q_ground is (T_g − T_base)/R, R the floor's r_floor, or the layer of
+    soil's where the version has one); the lag of the soil it was read at and the layer's depth,
+    reported only."""
     d = ext.detail
     r = params["r_floor"]
     # ISO 13370's U (``U_FLOOR``) spans the floor and the soil down to where the ground
-    # temperature is read; ISO 52016-1's virtual layer of soil is part of that path.
-    layer = d.get("soil_layer_r_m2k_w") or 0.0
+    # temperature is read; the layer of soil, d_soil/λ, is part of that path.
+    layer = params.get("d_soil", 0.0) / SOIL_CONDUCTIVITY
     t_ground = d["ground_base_c"] + params["q_ground"] * (layer or r)
     low = (
         min(d["ground_base_c"], d["outdoor_mean_c"])
@@ -368,6 +369,11 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             "months",
             "lag of the soil's annual wave behind the outdoor air's (1: a lightly insulated "
             "slab, 1.5: an insulated floor)",
+        ),
+        *(
+            [Reading("d_soil", params["d_soil"], "m", "depth of the layer of soil under the floor")]
+            if "d_soil" in params
+            else []
         ),
     ]
 

@@ -649,7 +649,9 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
 def _ground_words(f: Finding) -> str:
     """A ground version's reading: its lag, and the layer of soil where it has one."""
     words = f"{f.detail['ground_lag_months']:.1f} months"
-    return f"{words} through the layer of soil" if f.detail.get("soil_layer_r_m2k_w") else words
+    if not f.detail.get("soil_layer"):
+        return words
+    return f"{words} through {f.fit.params['d_soil']:.1f} m of soil"
 
 
 def _version_words(f: Finding) -> str:
