@@ -11,7 +11,7 @@ import pandas as pd
 from scipy.integrate import solve_ivp
 
 from rcengine.building import Building
-from rcengine.diagnose.candidates import Context
+from rcengine.diagnose.candidates import CANDIDATES, Context, Extension
 from rcengine.diagnose.fitting import fit_model, split_data
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
@@ -140,3 +140,14 @@ def fitted_context(frame: pd.DataFrame, model: str, fraction: float) -> Context:
     return Context(
         network, BUILDING, fit.split.train, SignalOptions(), fit.params, fit.residual_train
     )
+
+
+def ground_version(ctx: Context, layer: bool) -> Extension:
+    """The ground candidate's version read at a month's lag, with or without its layer of soil."""
+    ground = CANDIDATES["ground_coupling"](ctx)
+    (version,) = [
+        v
+        for v in (ground, *ground.alternatives)
+        if v.detail["soil_layer"] == layer and np.isclose(v.detail["ground_lag_months"], 1.0)
+    ]
+    return version

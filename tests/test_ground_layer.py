@@ -8,13 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rcengine.diagnose.candidates import CANDIDATES, SOIL_LAYER_DEPTH_ISO, Context, Extension
+from rcengine.diagnose.candidates import SOIL_LAYER_DEPTH_ISO, Context, Extension
 from rcengine.diagnose.plausibility import assess
 from rcengine.estimation import Estimator
 from rcengine.models import get_model
 from rcengine.signals import SignalOptions, prepare
 from rcengine.simulate import simulate
-from tests.synthetic import BUILDING, TRUTH_BASIC, weather_and_gains
+from tests.synthetic import BUILDING, TRUTH_BASIC, ground_version, weather_and_gains
 
 # A floor on 1.2 m of soil, 0.8 W/(m²K) from the slab to the soil's top, the soil 3 K warmer
 # than the undisturbed ground below it (q_ground = ΔT·λ/d). [m], [m²K/W], [W/m²]
@@ -24,16 +24,6 @@ WARM_UP_DAYS = 30
 RECORD_DAYS = 60
 # The sensor's noise. [K]
 NOISE_K = 0.05
-
-
-def _layered(ctx: Context) -> Extension:
-    ground = CANDIDATES["ground_coupling"](ctx)
-    (layered,) = [
-        v
-        for v in ground.alternatives
-        if v.detail["soil_layer"] and v.detail["ground_lag_months"] == pytest.approx(1.0)
-    ]
-    return layered
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +37,8 @@ def slab_record():
     network = get_model("basic", BUILDING, frame.columns)
     data = prepare(frame.assign(t_in=20.0), BUILDING, network.compile().input_names)
     zero = np.zeros(len(data))
-    layered = _layered(Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, zero))
+    context = Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, zero)
+    layered = ground_version(context, layer=True)
     compiled = layered.network.compile()
     data = prepare(frame.assign(t_in=20.0), BUILDING, compiled.input_names, layered.signals)
     truth = {**TRUTH_BASIC, **TRUTH_FLOOR}

@@ -49,7 +49,14 @@ from rcengine.signals.ground import (
 )
 from rcengine.signals.schedules import day_type_hour
 from scripts.energyplus.testbed import CLIMATES
-from tests.synthetic import BUILDING, TRUTH_BASIC, fitted_context, office, weather_and_gains
+from tests.synthetic import (
+    BUILDING,
+    TRUTH_BASIC,
+    fitted_context,
+    ground_version,
+    office,
+    weather_and_gains,
+)
 
 SMALL = office(
     name="small-office",
@@ -507,11 +514,7 @@ def test_the_layer_of_soil_is_fitted_in_depth_from_iso_52016_s(gain_context):
     read and the floor: C = ρc·d·A and R = d/(λ·A), both on the one fitted depth, searched from
     0.1 to 2 m and started at ISO 52016-1's 0.5 m, where it is the old fixed layer (1 MJ/(m²K),
     0.25 m²K/W); r_floor from the layer to the interior mass."""
-    (layered,) = [
-        v
-        for v in CANDIDATES["ground_coupling"](gain_context).alternatives
-        if v.detail["soil_layer"] and v.detail["ground_lag_months"] == pytest.approx(1.0)
-    ]
+    layered = ground_version(gain_context, layer=True)
     net, footprint = layered.network, SMALL.footprint_area
     (soil,) = [c for c in net.capacitors if c.node == "soil"]
     assert soil.capacity == "d_soil"
@@ -532,12 +535,7 @@ def test_the_soil_s_constant_heat_is_a_warmer_ground(gain_context, layer, d_soil
     ΔT/R on the node the ground is seen from (the floor's without the layer, the layer's with
     it, R = d_soil/λ at any depth): settled, q_ground raises the room as a ground ΔT = q·R
     warmer does, and the ground temperature read for plausibility is that one."""
-    ground = CANDIDATES["ground_coupling"](gain_context)
-    (version,) = [
-        v
-        for v in (ground, *ground.alternatives)
-        if v.detail["soil_layer"] == layer and v.detail["ground_lag_months"] == pytest.approx(1.0)
-    ]
+    version = ground_version(gain_context, layer)
     warmer = version.detail["ground_base_c"] + 3.0
     params = {**TRUTH_BASIC, **_ground(version, 0.8, warmer, *([d_soil] if layer else []))}
     r = d_soil / SOIL_CONDUCTIVITY if layer else params["r_floor"]

@@ -371,7 +371,7 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             "slab, 1.5: an insulated floor)",
         ),
         *(
-            [Reading("d_soil", params["d_soil"], "m", "depth of the layer of soil under the floor")]
+            [Reading("d_soil", params["d_soil"], "m", ext.network.parameters["d_soil"].description)]
             if "d_soil" in params
             else []
         ),
