@@ -224,6 +224,24 @@ def test_the_folds_choose_between_a_learnt_schedule_and_the_metered_use():
     assert better_learnt.detail["use_not_taken"] == "0.600 K pooled over the folds"
 
 
+def test_the_folds_choose_whether_an_unmetered_gain_has_a_base_load():
+    """The same gain with a base load at every hour is a version of the effect: kept where the
+    folds favour it, the version without it named, and the other way round."""
+    use = _version("unmetered_gains", "", 2.0, 0.6)
+    use.detail = {"follows": "q_occ + q_light"}
+    with_base = _version("unmetered_gains", "", 1.5, 0.4)
+    with_base.detail = {"follows": "q_occ + q_light", "base_load": True}
+    assert _one_version_each([use, with_base]) == [with_base]
+    assert with_base.detail["no_base_load_not_taken"] == (
+        "in step with q_occ + q_light: 0.600 K pooled over the folds"
+    )
+    learnt = _version("unmetered_gains", "Mon–Fri 08:00–18:00", 1.0, 0.3)
+    assert _one_version_each([with_base, learnt]) == [learnt]
+    assert learnt.detail["base_load_not_taken"] == (
+        "in step with q_occ + q_light: 0.400 K pooled over the folds"
+    )
+
+
 def _accepted(effect: str, round_no: int, repair: bool = False, folds: bool = True) -> Finding:
     """An accepted finding, on the folds' evidence unless ``folds`` is False (the opaque sun
     judged from the glazing's magnitude after the selection)."""

@@ -251,6 +251,22 @@ def test_a_gain_small_beside_the_metered_gains_is_rejected(gain_context):
     ]
 
 
+def test_a_base_load_is_read_per_square_metre_and_bounded_like_the_gain(gain_context):
+    """The version with a base load at every hour reads it in W/m² of floor, bounded like any
+    unmetered gain (a dense, equipment-heavy floor's 40 W/m²)."""
+    ext = CANDIDATES["unmetered_gains"](gain_context)
+    with_base = next(e for e in ext.alternatives if e.detail.get("base_load"))
+    assert "q_base_load" in with_base.new_parameters and "q_base_load" not in ext.new_parameters
+    fitted = assess(with_base, {**TRUTH_BASIC, "q_unmetered": 20.0, "q_base_load": 4.0})
+    assert fitted.plausible, fitted.problems
+    assert fitted.magnitudes["base_load_per_floor_area"]["value"] == 4.0
+    rejected = assess(with_base, {**TRUTH_BASIC, "q_unmetered": 20.0, "q_base_load": 60.0})
+    assert rejected.problems == [
+        "unmetered internal gain at every hour, per m² of floor (7200 W): 60 W/m² exceeds any "
+        "occupied floor (≤ 40 W/m²)"
+    ]
+
+
 def test_an_emitter_may_charge_the_slab_it_lies_on(gain_context, loss_context):
     """A heating mat on an uninsulated 200 mm slab under 90 mm of screed stores in both (≈ 580
     kJ/(m²K)); the heaviest emitter is a thermally activated 0.3 m slab, and past it nothing."""

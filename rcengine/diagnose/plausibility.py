@@ -286,8 +286,21 @@ def _unmetered(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             UNMETERED_W_M2,
             "occupied floor",
         ),
+        *_base_load(ext, params),
         *_occupied(ext.detail),
         *_beside_metered(ext.detail, q),
+    ]
+
+
+def _base_load(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
+    """The unmetered gain's load at every hour, where the candidate has one."""
+    if "q_base_load" not in params:
+        return []
+    q = params["q_base_load"]
+    floor = ext.detail["floor_area_m2"]
+    meaning = f"unmetered internal gain at every hour, per m² of floor ({q * floor:.0f} W)"
+    return [
+        Reading("base_load_per_floor_area", q, "W/m²", meaning, UNMETERED_W_M2, "occupied floor")
     ]
 
 

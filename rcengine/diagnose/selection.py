@@ -626,11 +626,14 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             chosen[f.effect] = f
             continue
         best, worse = sorted((other, f), key=rank)
-        if worse.evidence is not None and "schedule" in worse.detail:
-            pooled = worse.evidence.pooled_after
-            best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
-        if "follows" in worse.detail:
-            best.detail["use_not_taken"] = _version_words(worse)
+        if worse.detail.get("base_load", False) != best.detail.get("base_load", False):
+            _name_base_load_not_taken(best, worse)
+        else:
+            if worse.evidence is not None and "schedule" in worse.detail:
+                pooled = worse.evidence.pooled_after
+                best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+            if "follows" in worse.detail and "follows" not in best.detail:
+                best.detail["use_not_taken"] = _version_words(worse)
         if "ground_lag_months" in worse.detail:
             not_taken = (
                 best.detail.get("ground_lag_not_taken"),
@@ -644,6 +647,16 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             best.detail["convective_not_taken"] = _version_words(worse)
         chosen[f.effect] = best
     return list(chosen.values())
+
+
+def _name_base_load_not_taken(best: Finding, worse: Finding) -> None:
+    """An unmetered gain's version with a base load at every hour against one without: the
+    other named, with its shape, in ``base_load_not_taken`` or ``no_base_load_not_taken``
+    (each version not taken in turn)."""
+    key = "base_load_not_taken" if worse.detail.get("base_load") else "no_base_load_not_taken"
+    shape = worse.detail.get("schedule", f"in step with {worse.detail.get('follows')}")
+    words = (best.detail.get(key), worse.detail.get(key), f"{shape}: {_version_words(worse)}")
+    best.detail[key] = "; ".join(w for w in words if w)
 
 
 def _ground_words(f: Finding) -> str:

@@ -247,7 +247,7 @@ def _ground(
     frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
 ) -> pd.DataFrame:
     """t_ground: the outdoor annual cycle damped and lagged into the soil [°C] (its mean is
-    fitted on top, through a constant heat input on ``unit``); unit = 1 [-]."""
+    fitted on top, through a constant heat input on ``unit``)."""
     t_out = frame[T_OUT].to_numpy(dtype=float)
     latitude = building.location.latitude
     cycle = None if options.ground_cycle is None else AnnualCycle.from_dict(options.ground_cycle)
@@ -255,11 +255,17 @@ def _ground(
         {
             T_GROUND: seasonal_ground_temperature(
                 frame.index, t_out, latitude, options.ground_depth_m, cycle
-            ),
-            UNIT: np.ones(len(frame)),
+            )
         },
         index=frame.index,
     )
+
+
+def _unit(
+    frame: pd.DataFrame, building: Building, options: SignalOptions, wanted: Sequence[str]
+) -> pd.DataFrame:
+    """unit = 1 [-]: the signal of a constant heat input."""
+    return pd.DataFrame({UNIT: np.ones(len(frame))}, index=frame.index)
 
 
 def _sky(
@@ -281,7 +287,7 @@ def derivers(building: Building, options: SignalOptions) -> dict[str, Deriver]:
         VENT_LOSS: _vent_loss,
         **{schedule_signal_name(name): _schedules for name in options.schedules},
         T_GROUND: _ground,
-        UNIT: _ground,
+        UNIT: _unit,
         SKY_DELTA: _sky,
     }
 
