@@ -590,14 +590,14 @@ def ventilation_schedule(ctx: Context) -> Extension | Skipped:
 Q_UNMETERED = "q_unmetered"
 
 
+def _unmetered_per_floor(name: str, meaning: str) -> Parameter:
+    """An unmetered heat per m² of floor [W/m²], searched from none to past a dense floor's."""
+    return Parameter(name, "W/m²", 0.0, SEARCH_MARGIN * UNMETERED_W_M2[1], meaning)
+
+
 def _q_unmetered(hours: str) -> Parameter:
-    return Parameter(
-        Q_UNMETERED,
-        "W/m²",
-        0.0,
-        SEARCH_MARGIN * UNMETERED_W_M2[1],
-        f"unmetered internal heat (equipment, people) in the {hours} hours, per m² of floor",
-    )
+    meaning = f"unmetered internal heat (equipment, people) in the {hours} hours, per m² of floor"
+    return _unmetered_per_floor(Q_UNMETERED, meaning)
 
 
 def unmetered_gains(ctx: Context) -> Extension | Skipped:
@@ -612,10 +612,11 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     saturated = heater_saturated(ctx.train)
     learnt = _learnt_schedule(ctx, ctx.network.output, np.ones(len(ctx.data)), saturated)
     with_use = _gains_with_use(ctx)
+    uses = () if with_use is None else (with_use, _with_base_load(ctx, with_use))
     if not learnt.schedule.any():
-        if with_use is None:
+        if not uses:
             return Skipped(effect, "the residuals show no weekly pattern of missing heat")
-        return replace(with_use, alternatives=(_with_base_load(ctx, with_use),))
+        return replace(uses[0], alternatives=uses[1:])
     floor = ctx.building.floor_area
     heat = (SCHED_GAINS, ctx.network.output)
     on = _on_learnt_hours(ctx, learnt)
@@ -626,7 +627,6 @@ def unmetered_gains(ctx: Context) -> Extension | Skipped:
     }
     ext = _with_gain(ctx, effect, _q_unmetered("scheduled"), heat, detail, floor)
     ext = _on_schedule(ext, GAINS_SCHEDULE, learnt)
-    uses = () if with_use is None else (with_use, _with_base_load(ctx, with_use))
     return replace(ext, alternatives=(_with_base_load(ctx, ext), *uses))
 
 
@@ -651,15 +651,8 @@ def _with_base_load(ctx: Context, ext: Extension) -> Extension:
     test RMSE 0.50 K against 0.37), so only the folds may prefer it (``folds_only``)."""
     floor = ctx.building.floor_area
     net = ext.network.copy(ext.network.name)
-    net.add_parameter(
-        Parameter(
-            Q_BASE_LOAD,
-            "W/m²",
-            0.0,
-            SEARCH_MARGIN * UNMETERED_W_M2[1],
-            "unmetered internal heat at every hour (equipment left on), per m² of floor",
-        )
-    )
+    meaning = "unmetered internal heat at every hour (equipment left on), per m² of floor"
+    net.add_parameter(_unmetered_per_floor(Q_BASE_LOAD, meaning))
     net.add_heat_input(UNIT, net.output, Q_BASE_LOAD, factor=floor)
     return replace(
         ext,

@@ -635,12 +635,8 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             if "follows" in worse.detail and "follows" not in best.detail:
                 best.detail["use_not_taken"] = _version_words(worse)
         if "ground_lag_months" in worse.detail:
-            not_taken = (
-                best.detail.get("ground_lag_not_taken"),
-                worse.detail.get("ground_lag_not_taken"),
-                f"{_ground_words(worse)} ({_version_words(worse)})",
-            )
-            best.detail["ground_lag_not_taken"] = "; ".join(w for w in not_taken if w)
+            words = f"{_ground_words(worse)} ({_version_words(worse)})"
+            _add_not_taken(best, worse, "ground_lag_not_taken", words)
         if "radiant_to" in worse.detail:
             best.detail["radiant_not_taken"] = _version_words(worse)
         elif "radiant_to" in best.detail:
@@ -655,8 +651,14 @@ def _name_base_load_not_taken(best: Finding, worse: Finding) -> None:
     (each version not taken in turn)."""
     key = "base_load_not_taken" if worse.detail.get("base_load") else "no_base_load_not_taken"
     shape = worse.detail.get("schedule", f"in step with {worse.detail.get('follows')}")
-    words = (best.detail.get(key), worse.detail.get(key), f"{shape}: {_version_words(worse)}")
-    best.detail[key] = "; ".join(w for w in words if w)
+    _add_not_taken(best, worse, key, f"{shape}: {_version_words(worse)}")
+
+
+def _add_not_taken(best: Finding, worse: Finding, key: str, words: str) -> None:
+    """``best.detail[key]`` lists every version not taken: those named before on either side,
+    then ``words`` for ``worse``."""
+    named = (best.detail.get(key), worse.detail.get(key), words)
+    best.detail[key] = "; ".join(w for w in named if w)
 
 
 def _ground_words(f: Finding) -> str:
