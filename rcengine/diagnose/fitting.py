@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -75,12 +76,21 @@ class Fit:
     residual_test: np.ndarray
     simulated_train: np.ndarray  # [°C]
     simulated_test: np.ndarray
-    innovations_train: np.ndarray  # one-step-ahead Kalman errors [K]
-    innovations_test: np.ndarray
     n_params: int
     at_bounds: list[str]
     n_simulations: int
     split: Split
+
+    # One-step-ahead Kalman errors [K], filtered on demand: the diagnosis reads them of the
+    # baseline and the final model alone, and two filters per candidate refit cost a tenth of
+    # a diagnosis.
+    @cached_property
+    def innovations_train(self) -> np.ndarray:
+        return innovations(self.network.compile(), self.params, self.split.train)
+
+    @cached_property
+    def innovations_test(self) -> np.ndarray:
+        return innovations(self.network.compile(), self.params, self.split.test)
 
     @property
     def sse_train(self) -> float:
@@ -158,8 +168,6 @@ def fit_model(
         residual_test=y_test - simulated_test,
         simulated_train=est.trajectory_.y,
         simulated_test=simulated_test,
-        innovations_train=innovations(compiled, est.params_, split.train),
-        innovations_test=innovations(compiled, est.params_, split.test),
         n_params=est.space_.dim,
         at_bounds=list(est.at_bounds_),
         n_simulations=est.n_simulations_,
