@@ -10,9 +10,9 @@ parent's own small factorisations run faster on one thread too.
 from __future__ import annotations
 
 import multiprocessing
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 from threadpoolctl import threadpool_limits
 
@@ -41,3 +41,25 @@ def process_pool(
 ) -> ProcessPoolExecutor:
     """``workers`` processes limited to one BLAS/OpenMP thread each, then ``initializer``."""
     return ProcessPoolExecutor(workers, initializer=_start_worker, initargs=(initializer, initargs))
+
+
+T = TypeVar("T", covariant=True)
+
+
+class Job(Protocol[T]):
+    """Independent work that a worker process can run (picklable, with its arguments)."""
+
+    def run(self) -> T: ...
+
+
+def _run(job: Job[T]) -> T:
+    return job.run()
+
+
+def run_jobs(jobs: Sequence[Job[T]], workers: int) -> list[T]:
+    """Each job's result, in order, run on up to ``workers`` processes (1, or where this process
+    may not start any, ``can_start_processes``: in this process)."""
+    if workers <= 1 or len(jobs) <= 1 or not can_start_processes():
+        return [job.run() for job in jobs]
+    with process_pool(min(workers, len(jobs))) as pool:
+        return list(pool.map(_run, jobs))

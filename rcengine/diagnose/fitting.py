@@ -18,7 +18,7 @@ from rcengine.estimation.presets import EstimatorSettings
 from rcengine.kalman import kalman_filter
 from rcengine.metrics import effective_count, lag1_autocorrelation, rmse
 from rcengine.network import CompiledNetwork, RCNetwork
-from rcengine.parallel import can_start_processes, process_pool
+from rcengine.parallel import run_jobs
 from rcengine.signals import SignalOptions, prepare
 from rcengine.simulate import modal_system, simulate_modal
 
@@ -268,9 +268,5 @@ def trust_region(
 
 
 def fit_many(jobs: list[FitJob], workers: int) -> list[Fit]:
-    """Run independent fits, on up to ``workers`` processes (1, or where this process may not
-    start any, ``parallel.can_start_processes``: in this process)."""
-    if workers <= 1 or len(jobs) <= 1 or not can_start_processes():
-        return [job.run() for job in jobs]
-    with process_pool(min(workers, len(jobs))) as pool:
-        return list(pool.map(FitJob.run, jobs))
+    """Run independent fits, on up to ``workers`` processes (``parallel.run_jobs``)."""
+    return run_jobs(jobs, workers)

@@ -22,6 +22,7 @@ from rcengine.diagnose.response import node_responses
 from rcengine.estimation import Estimator, EstimatorSettings
 from rcengine.estimation.ga import GASettings
 from rcengine.estimation.pattern_search import GPSSettings
+from rcengine.parallel import run_jobs
 
 LOCAL_REFIT = EstimatorSettings(
     GASettings(population=16, generations=4, lhs=True),
@@ -47,6 +48,38 @@ def screen(ext: Extension, base: Fit, split: Split, random_state: int) -> Screen
     if ext.structural:
         return _local_refit(ext, base, split, random_state)
     return _projection(ext, base, split.train)
+
+
+@dataclass(frozen=True)
+class ScreenJob:
+    """One ``screen`` call, so that a round's structural screens (each a short refit) can go to
+    worker processes."""
+
+    ext: Extension
+    base: Fit
+    split: Split
+    random_state: int
+
+    def run(self) -> Screen:
+        return screen(self.ext, self.base, self.split, self.random_state)
+
+
+def screen_all(
+    extensions: list[Extension],
+    base: Fit,
+    splits: dict[str, Split],
+    random_state: int,
+    workers: int,
+) -> dict[str, Screen]:
+    """Every extension screened (by effect); the structural ones' refits on up to ``workers``
+    processes, the projections, a least squares each, in this one."""
+    refitted = [e for e in extensions if e.structural]
+    jobs = [ScreenJob(e, base, splits[e.effect], random_state) for e in refitted]
+    screens = dict(zip((e.effect for e in refitted), run_jobs(jobs, workers), strict=True))
+    for e in extensions:
+        if not e.structural:
+            screens[e.effect] = _projection(e, base, splits[e.effect].train)
+    return {e.effect: screens[e.effect] for e in extensions}
 
 
 def _projection(ext: Extension, base: Fit, train: Dataset) -> Screen:

@@ -90,7 +90,7 @@ from rcengine.diagnose.report import (
     reject_implausible,
     screened_only,
 )
-from rcengine.diagnose.screen import Screen, screen
+from rcengine.diagnose.screen import Screen, screen, screen_all
 from rcengine.diagnose.settings import DiagnoseSettings, split_time
 from rcengine.diagnose.whiteness import ljung_box
 from rcengine.models import get_model
@@ -681,9 +681,7 @@ def _round(problem: Problem, state: Selection, extensions: list[Extension]) -> F
     every verdict of the round is recorded in ``state.verdicts``."""
     settings, current, round_no = problem.settings, state.current, state.round_no
     splits = {e.effect: problem.split(e.network, e.signals) for e in extensions}
-    screens = {
-        e.effect: screen(e, current, splits[e.effect], settings.random_state) for e in extensions
-    }
+    screens = screen_all(extensions, current, splits, settings.random_state, settings.workers)
 
     # Screening is a linearisation; the first round refits every candidate for real, later
     # rounds the ``confirm`` most promising (all by default: a screen on a residual the fit has
