@@ -460,6 +460,16 @@ def test_clear_sky_ghi_and_index():
     np.testing.assert_allclose(index[(clear > 10) & np.isfinite(ghi) & (index < 1.5)], 0.5)
 
 
+def test_clear_sky_ghi_is_computed_once_per_record_and_handed_out_as_a_copy():
+    times = hourly("2017-06-21", 24)
+    first = clear_ghi(times, TORINO)
+    first[:] = -1.0  # a caller's own array: the next caller still gets the sky
+    again = clear_ghi(times, TORINO)
+    assert 800.0 < again.max() < 1050.0
+    np.testing.assert_array_equal(again, clear_ghi(pd.DatetimeIndex(list(times)), TORINO))
+    np.testing.assert_array_equal(again, clear_ghi(times.tz_convert("Europe/Rome"), TORINO))
+
+
 def test_linke_turbidity_is_pvlibs_daily_interpolation_without_its_deprecated_accessor():
     """Across a leap year and both turns of the year, the same values as pvlib's interpolated
     lookup (which reads pandas' deprecated ``dayofyear``), and no warning of our own."""
