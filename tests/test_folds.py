@@ -240,6 +240,10 @@ def test_the_folds_choose_whether_an_unmetered_gain_has_a_base_load():
     assert learnt.detail["base_load_not_taken"] == (
         "in step with q_occ + q_light: 0.400 K pooled over the folds"
     )
+    # The version the base-load one had beaten stays named after both lost.
+    assert learnt.detail["no_base_load_not_taken"] == (
+        "in step with q_occ + q_light: 0.600 K pooled over the folds"
+    )
 
 
 def _accepted(effect: str, round_no: int, repair: bool = False, folds: bool = True) -> Finding:

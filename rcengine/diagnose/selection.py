@@ -610,6 +610,10 @@ def _versions(
     return list(zip(extensions, fits, strict=True)) + [(ext, fit) for _, ext, fit in others]
 
 
+# The detail keys that name a version of an effect not taken (``_one_version_each``).
+NOT_TAKEN = "_not_taken"
+
+
 def _one_version_each(findings: list[Finding]) -> list[Finding]:
     """Per effect, the version the evidence favours: accepted before rejected, then the lower
     pooled test RMSE across the folds (where they judge), then the better training fit; the other
@@ -626,21 +630,23 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             chosen[f.effect] = f
             continue
         best, worse = sorted((other, f), key=rank)
+        _carry_not_taken(best, worse)
         if worse.detail.get("base_load", False) != best.detail.get("base_load", False):
             _name_base_load_not_taken(best, worse)
         else:
             if worse.evidence is not None and "schedule" in worse.detail:
                 pooled = worse.evidence.pooled_after
-                best.detail["schedule_not_taken"] = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+                words = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+                _add_not_taken(best, "schedule_not_taken", words)
             if "follows" in worse.detail and "follows" not in best.detail:
-                best.detail["use_not_taken"] = _version_words(worse)
+                _add_not_taken(best, "use_not_taken", _version_words(worse))
         if "ground_lag_months" in worse.detail:
             words = f"{_ground_words(worse)} ({_version_words(worse)})"
-            _add_not_taken(best, worse, "ground_lag_not_taken", words)
+            _add_not_taken(best, "ground_lag_not_taken", words)
         if "radiant_to" in worse.detail:
-            best.detail["radiant_not_taken"] = _version_words(worse)
+            _add_not_taken(best, "radiant_not_taken", _version_words(worse))
         elif "radiant_to" in best.detail:
-            best.detail["convective_not_taken"] = _version_words(worse)
+            _add_not_taken(best, "convective_not_taken", _version_words(worse))
         chosen[f.effect] = best
     return list(chosen.values())
 
@@ -651,13 +657,20 @@ def _name_base_load_not_taken(best: Finding, worse: Finding) -> None:
     (each version not taken in turn)."""
     key = "base_load_not_taken" if worse.detail.get("base_load") else "no_base_load_not_taken"
     shape = worse.detail.get("schedule", f"in step with {worse.detail.get('follows')}")
-    _add_not_taken(best, worse, key, f"{shape}: {_version_words(worse)}")
+    _add_not_taken(best, key, f"{shape}: {_version_words(worse)}")
 
 
-def _add_not_taken(best: Finding, worse: Finding, key: str, words: str) -> None:
-    """``best.detail[key]`` lists every version not taken: those named before on either side,
-    then ``words`` for ``worse``."""
-    named = (best.detail.get(key), worse.detail.get(key), words)
+def _carry_not_taken(best: Finding, worse: Finding) -> None:
+    """The versions ``worse`` had beaten before it lost to ``best`` stay named: each of its
+    ``*_not_taken`` entries is added to ``best``'s."""
+    for key, words in worse.detail.items():
+        if key.endswith(NOT_TAKEN) and words:
+            _add_not_taken(best, key, words)
+
+
+def _add_not_taken(best: Finding, key: str, words: str) -> None:
+    """``best.detail[key]`` lists every version not taken, in the order they lost."""
+    named = (best.detail.get(key), words)
     best.detail[key] = "; ".join(w for w in named if w)
 
 
