@@ -339,9 +339,17 @@ def diagnose(
         Path | None,
         typer.Option(help="write the final model's specification (for `fit --model-file`)"),
     ] = None,
+    finding: Annotated[
+        str | None,
+        typer.Option(
+            help="with --save-model: write the model the diagnosis refitted with this effect "
+            "instead of its final model, whether it accepted it or not"
+        ),
+    ] = None,
 ) -> None:
     """Locate model–data mismatch, name the missing physics, add it and show the fit improve."""
     from rcengine.diagnose import DiagnoseSettings, selection
+    from rcengine.diagnose.candidates import CANDIDATES
     from rcengine.diagnose.html import render
     from rcengine.diagnose.settings import TRAIN_FRACTION
 
@@ -352,6 +360,8 @@ def diagnose(
         )
     if model not in available_models():
         fail(f"invalid model {model!r}; choose from {sorted(available_models())}")
+    if finding is not None and (save_model is None or finding not in CANDIDATES):
+        fail(f"--finding names an effect of {sorted(CANDIDATES)} and needs --save-model")
     outputs = {"--json": json_out, "--html": html_out, "--save-model": save_model}
     for option, path in outputs.items():
         _output(path, option, data, building)
@@ -387,18 +397,24 @@ def diagnose(
             write_text_atomic(html_out, render(report))
             typer.echo(f"wrote {html_out}")
         if save_model:
-            _save_model(d, b, frame, model, save_model)
+            _save_model(d, b, frame, model, save_model, finding)
 
     _run(run)
 
 
 def _save_model(
-    report: dict, building: Building, frame: pd.DataFrame, model: str, path: Path
+    report: dict,
+    building: Building,
+    frame: pd.DataFrame,
+    model: str,
+    path: Path,
+    finding: str | None = None,
 ) -> None:
-    """The diagnosed model as a specification; the base model (as the diagnosis bounded it)
-    when nothing was accepted, so that `fit --model-file` always has a model to fit."""
-    if any(f["accepted"] for f in report["findings"]):
-        spec = ModelSpec.from_report(report, building, frame)
+    """The diagnosed model as a specification (with ``finding``, the one refitted with that
+    effect); the base model (as the diagnosis bounded it) when nothing was accepted, so that
+    `fit --model-file` always has a model to fit."""
+    if finding is not None or any(f["accepted"] for f in report["findings"]):
+        spec = ModelSpec.from_report(report, building, frame, finding=finding)
     else:
         final = report["final"]
         network = RCNetwork.from_dict(final["network"])

@@ -67,25 +67,39 @@ def spec_of(building: BuildingRecord) -> ModelSpec | None:
     return None if building.model_spec is None else ModelSpec.from_dict(building.model_spec)
 
 
+def _adopted_from(spec: ModelSpec | None) -> tuple[int | None, str | None]:
+    """The diagnosis and the finding (None: its final model) a model was adopted from."""
+    source = {} if spec is None else spec.source
+    return source.get("diagnosis_id"), source.get("finding")
+
+
 def job_model(spec: ModelSpec | None, default: str) -> str:
     """What a calibration job is labelled with: the adopted model's name, else ``default``."""
     return default if spec is None else spec.name
 
 
-def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> Change:
-    """Make diagnosis ``diagnosis_id``'s final model the building's; NotFoundError for another
-    building's or an unknown diagnosis, ModelError when it has nothing to adopt. The building's
-    row is locked: two adoptions at once on PostgreSQL both read "not adopted" and both said
-    they changed the model."""
+def adopt(
+    session: Session, building_id: int, diagnosis_id: int, actor: str, finding: str | None = None
+) -> Change:
+    """Make diagnosis ``diagnosis_id``'s final model the building's — or, with ``finding``, the
+    model it refitted with that effect, accepted or not (an engineer who knows the building has
+    it; the held-out day still decides what is served); NotFoundError for another building's or
+    an unknown diagnosis, ModelError when it has nothing to adopt. The building's row is locked:
+    two adoptions at once on PostgreSQL both read "not adopted" and both said they changed the
+    model."""
     building = repository.lock_building(session, building_id)
     diagnosis = session.get(DiagnosisRecord, diagnosis_id)
     if diagnosis is None or diagnosis.building_id != building_id:
         raise NotFoundError(f"diagnosis {diagnosis_id} not found for building {building_id}")
     current = spec_of(building)
-    if current is not None and current.source.get("diagnosis_id") == diagnosis_id:
-        return Change(_audit(session, building_id, ADOPT, actor, current, diagnosis_id), current)
+    detail = None if finding is None else {"finding": finding}
+    if _adopted_from(current) == (diagnosis_id, finding):
+        record = _audit(session, building_id, ADOPT, actor, current, diagnosis_id, detail=detail)
+        return Change(record, current)
     description = bridge.building_of(building.description)
-    spec = ModelSpec.from_report(diagnosis.report, description, diagnosis_id=diagnosis_id)
+    spec = ModelSpec.from_report(
+        diagnosis.report, description, diagnosis_id=diagnosis_id, finding=finding
+    )
     if spec.needs_record:  # the ground's annual cycle, fitted once to the diagnosed record
         frame = bridge.load_frame(
             session,
@@ -95,7 +109,9 @@ def adopt(session: Session, building_id: int, diagnosis_id: int, actor: str) -> 
         )
         spec = spec.with_fixed_signals(frame, description)
     building.model_spec = _document(spec)
-    record = _audit(session, building_id, ADOPT, actor, spec, diagnosis_id, changed=True)
+    if finding is not None:
+        detail = {"finding": finding, "accepted_by_the_diagnosis": spec.source["accepted"]}
+    record = _audit(session, building_id, ADOPT, actor, spec, diagnosis_id, True, detail)
     return Change(record, spec)
 
 

@@ -19,6 +19,7 @@ from rcengine.diagnose.response import explain_residual, node_responses, on_off_
 from rcengine.estimation import Estimator
 from rcengine.io.timeseries import read_timeseries
 from rcengine.models import get_model
+from rcengine.models.spec import ModelSpec
 from rcengine.signals import SignalOptions
 from rcengine.signals.schedules import CLOCKS, clock_zone
 from rcengine.simulate import simulate
@@ -249,6 +250,12 @@ def test_hidden_weekly_gain_is_found_named_and_fixed(hidden_gain_record):
     # The hidden gain switches on at 07:00 on weekdays: the one-step errors are largest then.
     assert np.nanargmax(np.nanmean(innovations[:5], axis=0)) in (7, 8)
     assert d["final"]["model"].startswith("basic+unmetered_gains")
+    # Every refitted finding carries its model, so an engineer may adopt one by name.
+    for f in d["findings"]:
+        if f["rmse_test_after"] is not None:
+            assert f["model"]["network"]["name"].endswith(f"+{f['effect']}")
+            spec = ModelSpec.from_report(d, BUILDING, finding=f["effect"])
+            assert spec.effects[-1] == f["effect"] and spec.source["accepted"] == f["accepted"]
     # What the MPC would have been served over the test half's days: the gain helps there too.
     ahead = d["day_ahead"]
     assert ahead["days"] >= 7 and ahead["horizon_h"] == 24.0

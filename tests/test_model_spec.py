@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from rcengine.columns import (
+    SKY_DELTA,
     T_GROUND,
     UNIT,
     VENT_LOSS,
@@ -135,6 +136,39 @@ def test_a_report_without_a_final_network_or_findings_cannot_be_adopted(frame):
     nothing["findings"] = [{"effect": "sky_radiation", "accepted": False}]
     with pytest.raises(ModelError, match="nothing to adopt"):
         ModelSpec.from_report(nothing, BUILDING, frame)
+
+
+def sky_network():
+    """Basic with the wind the round before accepted and a sky the diagnosis rejected."""
+    net = get_model("basic", BUILDING).copy("basic+wind_infiltration+sky_radiation")
+    per_ach = 1.2 * 1005.0 * BUILDING.volume / 3600.0
+    net.add_parameter(Parameter("ach_wind", "1/h per m/s", 0.0, 2.0, "wind air changes"))
+    net.add_parameter(Parameter("u_sky", "W/(m²K)", 0.0, 5.0, "sky exchange"))
+    net.add_heat_input(WIND_LOSS, net.output, "ach_wind", factor=per_ach)
+    net.add_heat_input(SKY_DELTA, net.states[0], "u_sky", factor=100.0)
+    return net
+
+
+def test_a_finding_the_diagnosis_rejected_can_be_adopted_by_name(frame):
+    """An engineer may adopt a refitted finding the diagnosis did not accept: the model of its
+    round with the effect added; one only screened, or never judged, is a clear error."""
+    diagnosed = report(extended_network())
+    sky = sky_network()
+    options = SignalOptions(cloud_cover="estimated")
+    diagnosed["findings"][1]["model"] = {"network": sky.to_dict(), "signals": options.to_dict()}
+    spec = ModelSpec.from_report(
+        diagnosed, BUILDING, frame, diagnosis_id=3, finding="sky_radiation"
+    )
+    assert spec.name == "basic+wind_infiltration+sky_radiation"
+    assert spec.effects == ("wind_infiltration", "sky_radiation")
+    assert spec.source["finding"] == "sky_radiation" and spec.source["accepted"] is False
+    assert set(spec.source["details"]) == {"wind_infiltration", "sky_radiation"}
+    assert SKY_DELTA in spec.inputs and "u_sky" in spec.rc.parameters
+    assert ModelSpec.from_json(spec.to_json()) == spec
+    with pytest.raises(ModelError, match="screened, not refitted"):
+        ModelSpec.from_report(diagnosed, BUILDING, finding="wind_infiltration")
+    with pytest.raises(ModelError, match="judged no 'ground_coupling'"):
+        ModelSpec.from_report(diagnosed, BUILDING, finding="ground_coupling")
 
 
 def test_older_documents_load_and_unreadable_ones_say_why(frame):
@@ -259,3 +293,20 @@ def test_diagnose_saves_the_model_that_fit_then_calibrates(tmp_path, monkeypatch
         cli.app, ["fit", "data.csv", "-b", "b.json", "--model-file", "p.json", "-o", "q.json"]
     )
     assert wrong.exit_code == 2 and "not a model specification" in wrong.output
+    # A finding the diagnosis refitted but did not accept, saved by name.
+    rejected = wind_report()
+    rejected["findings"][0] |= {"accepted": False, "model": dict(rejected.pop("final"))}
+    rejected["final"] = {
+        **rejected["findings"][0]["model"],
+        "network": get_model("basic", BUILDING).to_dict(),
+    }
+    fake = SimpleNamespace(to_dict=lambda: rejected, findings=[], wall_time_s=0.1)
+    monkeypatch.setattr(selection, "diagnose", lambda *a, **k: fake)
+    named = runner.invoke(cli.app, [*save[:-1], "n.json", "--finding", "wind_infiltration"])
+    assert named.exit_code == 0, named.output
+    assert ModelSpec.load("n.json").effects == ("wind_infiltration",)
+    assert ModelSpec.load("n.json").source["accepted"] is False
+    alone = runner.invoke(cli.app, [*save[:-2], "--finding", "wind_infiltration"])
+    assert alone.exit_code == 2 and "needs --save-model" in alone.output
+    unknown = runner.invoke(cli.app, [*save[:-1], "u.json", "--finding", "windows"])
+    assert unknown.exit_code == 2 and "--finding names an effect of" in unknown.output

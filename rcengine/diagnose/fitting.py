@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -91,6 +92,11 @@ class Fit:
     @cached_property
     def innovations_test(self) -> np.ndarray:
         return innovations(self.network.compile(), self.params, self.split.test)
+
+    def model_document(self) -> dict[str, Any]:
+        """What rebuilds this fitted model exactly (``rcengine.models.spec.ModelSpec``): its
+        network and signal settings, as JSON data."""
+        return {"network": self.network.to_dict(), "signals": self.options.to_dict()}
 
     @property
     def sse_train(self) -> float:

@@ -107,6 +107,9 @@ class Finding:
             "lost_to": self.lost_to,
             "baseline_repair": self.baseline_repair,
             "backward": self.backward,
+            # The refitted model with this finding, accepted or not, so that it can be adopted
+            # by name (``ModelSpec.from_report(..., finding=...)``); None where only screened.
+            "model": None if self.fit is None else self.fit.model_document(),
         }
 
 
@@ -477,8 +480,7 @@ class Report:
                 "rmse_test": self.final.rmse_test,
                 "parameters": self.final.params,
                 # What rebuilds the final model exactly (rcengine.models.spec.ModelSpec).
-                "network": self.final.network.to_dict(),
-                "signals": self.final.options.to_dict(),
+                **self.final.model_document(),
             },
             "verdict": verdict(self.findings, self.health),
             "evidence": {

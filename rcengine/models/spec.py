@@ -141,12 +141,18 @@ class ModelSpec:
         building: Building,
         frame: pd.DataFrame | None = None,
         diagnosis_id: int | None = None,
+        finding: str | None = None,
     ) -> ModelSpec:
-        """The final model of a diagnosis report (``Report.to_dict``, as stored). With the
-        record ``frame`` it diagnosed, slow signals fitted to that record (the ground's annual
+        """The final model of a diagnosis report (``Report.to_dict``, as stored), or with
+        ``finding`` the refitted model that adds that effect, whether the diagnosis accepted it or
+        not (an engineer's choice, which a calibration's held-out day still has to bear out). With
+        the record ``frame`` it diagnosed, slow signals fitted to that record (the ground's annual
         cycle) are fixed (``with_fixed_signals``), so that a one-day forecast sees the ground the
         months of the diagnosis saw; ``needs_record`` says whether that is needed.
         """
+        if finding is not None:
+            spec = cls._of_finding(report, building, finding, diagnosis_id)
+            return spec if frame is None else spec.with_fixed_signals(frame, building)
         final = report.get("final") or {}
         if "network" not in final or "signals" not in final:
             raise ModelError(
@@ -171,6 +177,42 @@ class ModelSpec:
             building=building_key(building),
         )
         return spec if frame is None else spec.with_fixed_signals(frame, building)
+
+    @classmethod
+    def _of_finding(
+        cls, report: dict[str, Any], building: Building, effect: str, diagnosis_id: int | None
+    ) -> ModelSpec:
+        """The model a report's finding on ``effect`` was refitted as: the model of its round
+        (the base model and the extensions accepted before) with the effect added."""
+        judged = {f["effect"]: f for f in report.get("findings", [])}
+        if effect not in judged:
+            named = ", ".join(judged) or "none"
+            raise ModelError(f"the diagnosis judged no '{effect}' (it judged: {named})")
+        model = judged[effect].get("model")
+        if not model:
+            raise ModelError(
+                f"'{effect}' was screened, not refitted (or the report was written by an older "
+                "engine): the diagnosis holds no fitted model with it; diagnose again with only "
+                "that effect to refit it"
+            )
+        base = report["baseline"]["model"]
+        rc = RCNetwork.from_dict(model["network"])
+        # Each extension names its network ``<model>+<effect>`` (``candidates._name``).
+        effects = tuple(rc.name.removeprefix(f"{base}+").split("+"))
+        return cls(
+            base_model=base,
+            rc=rc,
+            signals=_signal_options(model["signals"]),
+            effects=effects,
+            source={
+                "kind": "diagnosis",
+                "diagnosis_id": diagnosis_id,
+                "finding": effect,
+                "accepted": bool(judged[effect].get("accepted")),
+                "details": {e: judged[e].get("detail", {}) for e in effects if e in judged},
+            },
+            building=building_key(building),
+        )
 
     @property
     def needs_record(self) -> bool:

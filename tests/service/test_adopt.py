@@ -91,6 +91,7 @@ def fake_report(accepted: bool = True, lowest: float = 0.0) -> dict:
                 "rmse_test_before": 1.2,
                 "rmse_test_after": 0.1,
                 "detail": {"volume_m3": 3150.0},
+                "model": {"network": net.to_dict(), "signals": SignalOptions().to_dict()},
             }
         ],
         "final": {
@@ -299,6 +300,32 @@ def test_what_cannot_be_adopted_is_said(client, building, adopted, monkeypatch):
     nothing = diagnosed(client, building_id, headers, monkeypatch, accepted=False)
     response = client.post(f"/buildings/{building_id}/diagnoses/{nothing}/adopt", headers=headers)
     assert response.status_code == 422 and "nothing to adopt" in response.json()["detail"]
+
+
+def test_a_finding_the_diagnosis_rejected_is_adopted_by_name(client, truth, monkeypatch):
+    """An engineer adopts the refitted wind the diagnosis did not accept: its model becomes the
+    building's, audited with the finding and the diagnosis's verdict, calibrated at once."""
+    building_id, headers = register(client)
+    upload = truth.iloc[: 4 * DAY]
+    url = f"/buildings/{building_id}/measurements"
+    assert client.post(url, json={"rows": json_rows(upload)}, headers=headers).status_code == 200
+    diagnosis_id = diagnosed(client, building_id, headers, monkeypatch, accepted=False)
+    adopt = f"/buildings/{building_id}/diagnoses/{diagnosis_id}/adopt"
+    final = client.post(adopt, headers=headers)
+    assert final.status_code == 422 and "nothing to adopt" in final.json()["detail"]
+    unjudged = client.post(adopt, params={"finding": "sky_radiation"}, headers=headers)
+    assert unjudged.status_code == 422
+    assert "judged no 'sky_radiation' (it judged: wind_infiltration)" in unjudged.json()["detail"]
+    answer = client.post(adopt, params={"finding": "wind_infiltration"}, headers=headers)
+    assert answer.status_code == 200, answer.text
+    body = answer.json()
+    assert body["changed"] and body["model"] == "basic+wind_infiltration"
+    assert body["detail"] == {"finding": "wind_infiltration", "accepted_by_the_diagnosis": False}
+    assert body["model_in_use"]["effects"] == ["wind_infiltration"]
+    job = wait_for_job(client, body["calibration_job_id"], headers)
+    assert job["status"] == "succeeded" and job["model"] == "basic+wind_infiltration"
+    again = client.post(adopt, params={"finding": "wind_infiltration"}, headers=headers).json()
+    assert not again["changed"] and again["detail"] == {"finding": "wind_infiltration"}
 
 
 def test_migration_0004_adds_and_removes_the_adoption_tables(tmp_path):

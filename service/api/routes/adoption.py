@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter, Depends, Query
 
 from ... import adoption
 from ...schemas.adoption import ModelChangeAnswer, ModelChangeList, ModelChangeRead
@@ -21,8 +21,21 @@ ADOPT_TEXT = (
     "served only if it beats the current set on the held-out day, as any calibration's, so "
     "adopting a model that does not forecast better changes nothing served. Adopting the "
     "adopted diagnosis again changes nothing (`changed: false`); every call is audited. 422 if "
-    "the diagnosis accepted no extension."
+    "the diagnosis accepted no extension. With `finding`, the model the diagnosis refitted with "
+    "that effect is adopted instead, whether it accepted it or not — for an engineer who knows "
+    "the building has it where the record was too short to show it beyond the diagnosis's "
+    "margins; the held-out day still decides what is served (422 if the diagnosis did not "
+    "refit that effect)."
 )
+FindingQuery = Annotated[
+    str | None,
+    Query(
+        description="Adopt the model the diagnosis refitted with this effect (a vocabulary id "
+        "among its findings), accepted or not, instead of its final model",
+        max_length=64,
+        examples=["window_solar_gains"],
+    ),
+]
 REVERT_TEXT = (
     "Back to the base model: calibrations fit it from now on (one starts at once), and the "
     "base-model set served before the adoption is served again now. Reverting a base model "
@@ -48,9 +61,10 @@ def adopt_diagnosis(
     diagnosis_id: Annotated[int, id_in_path("Diagnosis", 3)],
     ctx: ContextDep,
     actor: ActorDep,
+    finding: FindingQuery = None,
 ) -> ModelChangeAnswer:
     with ctx.db.write() as session:
-        change = adoption.adopt(session, building_id, diagnosis_id, actor)
+        change = adoption.adopt(session, building_id, diagnosis_id, actor, finding)
     return _answer(ctx, building_id, change)
 
 
