@@ -16,11 +16,13 @@ import pytest
 
 from rcengine.columns import (
     SKY_DELTA,
+    SOLAR_WINDOW,
     T_GROUND,
     UNIT,
     VENT_LOSS,
     VENT_SCHEDULE,
     WIND_LOSS,
+    solar_orientation_signal,
 )
 from rcengine.exceptions import DataValidationError, ModelError
 from rcengine.models import get_model
@@ -31,7 +33,7 @@ from rcengine.models.spec import (
     check_future_columns,
     columns_needed,
 )
-from rcengine.network import Parameter
+from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions, prepare
 from rcengine.simulate import simulate
 
@@ -169,6 +171,52 @@ def test_a_finding_the_diagnosis_rejected_can_be_adopted_by_name(frame):
         ModelSpec.from_report(diagnosed, BUILDING, finding="wind_infiltration")
     with pytest.raises(ModelError, match="judged no 'ground_coupling'"):
         ModelSpec.from_report(diagnosed, BUILDING, finding="ground_coupling")
+
+
+def window_report(g: dict[str, float]) -> dict:
+    """Basic with the window candidate's extra g-value per orientation, accepted at ``g``."""
+    net = get_model("basic", BUILDING).copy("basic+window_solar_gains")
+    for key in g:
+        net.add_parameter(Parameter(f"g_window_{key}", "-", 0.0, 1.5, f"extra g {key}"))
+        net.add_heat_input(solar_orientation_signal(SOLAR_WINDOW, key), "int", f"g_window_{key}")
+    new = {f"g_window_{k}": v for k, v in g.items()}
+    model = {"network": net.to_dict(), "signals": SignalOptions().to_dict()}
+    finding = {
+        "effect": "window_solar_gains",
+        "accepted": True,
+        "detail": {"orientations": {key: {} for key in g}},
+        "parameters": new,
+        "model": model,
+    }
+    final = {**model, "parameters": {**TRUTH_BASIC, **new}}
+    return {"baseline": {"model": "basic"}, "findings": [finding], "final": final}
+
+
+def test_the_diagnosed_split_across_facades_is_kept_and_one_scale_fitted():
+    """A fortnight's calibration cannot tell which facade has the extra glass, as the months of
+    the diagnosis did: the specification keeps the diagnosed shares and fits one scale, and at
+    the diagnosed value it is the diagnosis's model."""
+    diagnosed = window_report({"90_90": 0.4, "270_90": 0.1, "0_90": 0.0})
+    spec = ModelSpec.from_report(diagnosed, BUILDING)
+    scale = spec.rc.parameters["g_window_scale"]
+    assert (scale.lower, scale.upper) == (0.0, 1.5)
+    assert "(90_90 1.00, 270_90 0.25, 0_90 0.00)" in scale.description
+    assert not [p for p in spec.rc.parameters if p.startswith("g_window_") and p[9].isdigit()]
+    east, west, north = (solar_orientation_signal(SOLAR_WINDOW, k) for k in ("90", "270", "0"))
+    assert {east + "_90", west + "_90"} <= set(spec.inputs)
+    assert north + "_90" not in spec.inputs  # the facade fitted at zero drops out
+    original = RCNetwork.from_dict(diagnosed["final"]["network"]).compile()
+    kept = spec.rc.compile()
+    at_diagnosis = kept.rc_matrices({**TRUTH_BASIC, "g_window_scale": 0.4})
+    fitted = original.rc_matrices(diagnosed["final"]["parameters"])
+    columns = [original.input_names.index(name) for name in kept.input_names]
+    assert np.allclose(at_diagnosis.F, fitted.F[..., columns], rtol=1e-12, atol=0.0)
+    assert ModelSpec.from_json(spec.to_json()) == spec
+    named = ModelSpec.from_report(diagnosed, BUILDING, finding="window_solar_gains")
+    assert named.rc.parameters["g_window_scale"] == scale
+    # Nothing fitted above zero: the orientations are left as they are.
+    nothing = ModelSpec.from_report(window_report({"90_90": 0.0, "270_90": 0.0}), BUILDING)
+    assert {"g_window_90_90", "g_window_270_90"} <= set(nothing.rc.parameters)
 
 
 def test_older_documents_load_and_unreadable_ones_say_why(frame):

@@ -42,6 +42,12 @@ from rcengine.columns import (
 from rcengine.exceptions import DataValidationError, ModelError, Problem
 from rcengine.io.files import write_text_atomic
 from rcengine.io.jsonable import jsonable, read_json
+from rcengine.models.frozen_split import (
+    WINDOW_EFFECT,
+    WINDOW_SCALE,
+    frozen_split,
+    window_parameters,
+)
 from rcengine.network import RCNetwork
 from rcengine.signals import SignalOptions
 from rcengine.signals.ground import annual_cycle
@@ -152,6 +158,7 @@ class ModelSpec:
         """
         if finding is not None:
             spec = cls._of_finding(report, building, finding, diagnosis_id)
+            spec = spec.with_diagnosed_split(_window_fit(report))
             return spec if frame is None else spec.with_fixed_signals(frame, building)
         final = report.get("final") or {}
         if "network" not in final or "signals" not in final:
@@ -176,6 +183,7 @@ class ModelSpec:
             },
             building=building_key(building),
         )
+        spec = spec.with_diagnosed_split({**_window_fit(report), **final.get("parameters", {})})
         return spec if frame is None else spec.with_fixed_signals(frame, building)
 
     @classmethod
@@ -213,6 +221,15 @@ class ModelSpec:
             },
             building=building_key(building),
         )
+
+    def with_diagnosed_split(self, fitted: dict[str, float]) -> ModelSpec:
+        """This specification with the window gains' split across orientations, as ``fitted``
+        by the diagnosis, kept and one scale left to fit (``frozen_split``)."""
+        detail = self.source.get("details", {}).get(WINDOW_EFFECT)
+        if detail is None:
+            return self
+        rc = frozen_split(self.rc, fitted, window_parameters(detail), WINDOW_SCALE)
+        return self if rc is self.rc else replace(self, rc=rc)
 
     @property
     def needs_record(self) -> bool:
@@ -298,6 +315,12 @@ def _upgrade(data: Any) -> dict[str, Any]:
             f"{list(READABLE_VERSIONS)}); adopt the diagnosis or save the model again"
         )
     return data
+
+
+def _window_fit(report: dict[str, Any]) -> dict[str, float]:
+    """The window gains' per-orientation values as the diagnosis fitted them, where it did."""
+    window = [f for f in report.get("findings", []) if f.get("effect") == WINDOW_EFFECT]
+    return dict(window[0].get("parameters") or {}) if window else {}
 
 
 def _signal_options(data: dict[str, Any]) -> SignalOptions:

@@ -20,11 +20,10 @@ on its test half) nor sky radiation (−13 %, 0.082 K with the dew-point sky): b
 the 0.1 K margin, so the diagnosis's final model is the base model (the full-season diagnosis,
 docs/diagnosis.md, which has seen the test weeks, finds both). Both were refitted, so an
 engineer who knows the building has them adopts that finding by name (``BY_NAME``, the adopt
-call's ``finding``); the held-out day still decides what is served. The sky's model wins it and
-serves a better week. The window's does not (``KNOWN``, expected to fail): calibrated on the 14
-days before March it leaves every orientation's extra g-value at zero (the declared glazing's
-one g-value carries the sun), 7 of its 12 parameters end on a bound, and the promotion gate
-refuses the set, so the base model stays served.
+call's ``finding``); the held-out day still decides what is served. The window's model keeps
+the diagnosed split of its extra glass across the facades and fits one scale
+(``rcengine.models.frozen_split``): calibrated on the 14 days before March with a g-value per
+facade, every one fell to zero and the promotion gate refused the set.
 
 The diagnosis here is a single split with one baseline search (``engine_settings`` patched): what
 is tested is what adoption does with a diagnosis, not how thoroughly the diagnosis looks
@@ -115,22 +114,10 @@ def week_rmse(client, building_id, headers, frame: pd.DataFrame, first: pd.Times
 # Effects adopted by name (``?finding=``): the engineer's choice where the diagnosis refitted
 # them but its margins did not accept them.
 BY_NAME = ("window_solar_gains", "sky_radiation")
-KNOWN = {
-    "window_solar_gains": "adopted by name, its calibration on the 14 days before March leaves "
-    "every orientation's g at zero and the gate refuses it (7 of 12 parameters on a bound)",
-}
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=False))
-        if name in KNOWN
-        else name
-        for name in CASES
-    ],
-)
+@pytest.mark.parametrize("name", CASES)
 def test_the_adopted_model_serves_a_better_day_ahead_forecast(client, quick_diagnosis, name):
     case = MANIFEST[name]
     description = json.loads((VARIANTS / name / "building.json").read_text())
