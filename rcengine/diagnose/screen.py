@@ -73,13 +73,10 @@ def screen_all(
 ) -> dict[str, Screen]:
     """Every extension screened (by effect); the structural ones' refits on up to ``workers``
     processes, the projections, a least squares each, in this one."""
-    refitted = [e for e in extensions if e.structural]
-    jobs = [ScreenJob(e, base, splits[e.effect], random_state) for e in refitted]
-    screens = dict(zip((e.effect for e in refitted), run_jobs(jobs, workers), strict=True))
-    for e in extensions:
-        if not e.structural:
-            screens[e.effect] = _projection(e, base, splits[e.effect].train)
-    return {e.effect: screens[e.effect] for e in extensions}
+    jobs = {e.effect: ScreenJob(e, base, splits[e.effect], random_state) for e in extensions}
+    refitted = [e.effect for e in extensions if e.structural]
+    screens = dict(zip(refitted, run_jobs([jobs[e] for e in refitted], workers), strict=True))
+    return {e.effect: screens.get(e.effect) or jobs[e.effect].run() for e in extensions}
 
 
 def _projection(ext: Extension, base: Fit, train: Dataset) -> Screen:

@@ -183,7 +183,7 @@ class ModelSpec:
             },
             building=building_key(building),
         )
-        spec = spec.with_diagnosed_split({**_window_fit(report), **final.get("parameters", {})})
+        spec = spec.with_diagnosed_split(final.get("parameters", {}))
         return spec if frame is None else spec.with_fixed_signals(frame, building)
 
     @classmethod
