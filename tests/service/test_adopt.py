@@ -326,6 +326,9 @@ def test_a_finding_the_diagnosis_rejected_is_adopted_by_name(client, truth, monk
     assert job["status"] == "succeeded" and job["model"] == "basic+wind_infiltration"
     again = client.post(adopt, params={"finding": "wind_infiltration"}, headers=headers).json()
     assert not again["changed"] and again["detail"] == {"finding": "wind_infiltration"}
+    # The refused calls left no audit row.
+    changes = client.get(f"/buildings/{building_id}/model/changes", headers=headers).json()
+    assert [c["changed"] for c in changes["items"]] == [True, False]
 
 
 def test_migration_0004_adds_and_removes_the_adoption_tables(tmp_path):
