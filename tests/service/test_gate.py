@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rcengine.network import Parameter, RCNetwork
 from service.promotion import judge
 
 from .conftest import DAY, json_rows, register
@@ -73,6 +74,7 @@ class FittedSet:
 
     values: dict = field(default_factory=lambda: dict.fromkeys("abcdefgh", 1.0))
     fit: dict = field(default_factory=lambda: {"at_bounds": []})
+    network: RCNetwork = field(default_factory=lambda: RCNetwork("made up"))
 
 
 @pytest.fixture
@@ -92,6 +94,27 @@ def test_most_parameters_on_bounds_are_refused(days):
     verdict = judge(pinned, training, holdout, holdout["t_in"].to_numpy())
     assert verdict.refused_by == ["parameters_inside_bounds"]
     assert "6 of 8 parameters ended on a bound" in verdict.reason()
+
+
+def test_gains_resting_at_zero_do_not_count_as_pinned(days):
+    """Six of eight parameters on a bound, four of them non-negative gains at zero (their
+    effect idle over the training days): two are pinned, within the gate's half."""
+    training, holdout = days
+    network = RCNetwork("with gains")
+    for name in "abcd":
+        network.add_parameter(Parameter(name, "W/m²", 0.0, 20.0, "a gain that cannot be negative"))
+    network.add_parameter(Parameter("e", "m²K/W", 0.05, 5.0, "a resistance"))
+    values = {**dict.fromkeys("abcdefgh", 1.0), **dict.fromkeys("abcd", 0.0), "e": 0.05}
+    fitted = FittedSet(values, {"at_bounds": list("abcdef")}, network)
+    verdict = judge(fitted, training, holdout, holdout["t_in"].to_numpy())
+    assert verdict.passed
+    check = next(c for c in verdict.checks if c.name == "parameters_inside_bounds")
+    assert check.message.startswith("2 of 8 parameters ended on a bound (e, f;")
+    assert check.message.endswith("resting at zero, not counted: a, b, c, d")
+    # The same gains away from zero but on their upper bound are pinned.
+    pinned = FittedSet({**values, **dict.fromkeys("abcd", 20.0)}, fitted.fit, network)
+    verdict = judge(pinned, training, holdout, holdout["t_in"].to_numpy())
+    assert verdict.refused_by == ["parameters_inside_bounds"]
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, 7e304, -40.0])
