@@ -47,7 +47,8 @@ class Finding:
     passed; baseline_repair: taken to make an inadequate base model healthy, not judged as a
     candidate; backward: what leaving it out of the final model costs across the folds (the
     backward check of an accepted finding); absent: the values of its new parameters at which it
-    is left out (``Extension.absent``).
+    is left out (``Extension.absent``); extension: the candidate this verdict is on;
+    plausible: False where a fitted magnitude is implausible for the building.
     """
 
     effect: str
@@ -77,6 +78,8 @@ class Finding:
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
     short_of_bic: bool = False
+    extension: Extension | None = None
+    plausible: bool = True
 
     @property
     def improvement_k(self) -> float:
@@ -260,6 +263,7 @@ def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: 
         return
     text = "implausible: " + "; ".join(problems)
     finding.short_of_bic = False
+    finding.plausible = False
     finding.reason = f"rejected as {text}" if finding.accepted else f"{finding.reason}; {text}"
     finding.accepted = False
 
@@ -291,6 +295,7 @@ def _finding(
         rmse_train_before=current.rmse_train,
         absent=dict(ext.neutral if ext.absent is None else ext.absent),
         screen=screened,
+        extension=ext,
         **verdict,
     )
 
