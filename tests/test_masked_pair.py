@@ -11,22 +11,13 @@ from rcengine.diagnose import DiagnoseSettings, diagnose
 from rcengine.diagnose.report import Finding
 from rcengine.diagnose.selection import Selection, _near_miss
 from rcengine.io.timeseries import read_timeseries
+from tests.test_diagnose_evidence import _finding
 
 
-def _verdict(effect: str, delta_bic: float, after: float, **fields) -> Finding:
-    """A made-up verdict of round 1, refitted: test RMSE 1.0 K → ``after``."""
-    defaults = dict(
-        round=1,
-        screen_explained=0.5,
-        screen_method="projection",
-        rmse_test_before=1.0,
-        rmse_train_before=1.0,
-        rmse_test_after=after,
-        rmse_train_after=0.5,
-        delta_bic=delta_bic,
-        fit=object(),
-    )
-    return Finding(effect, False, **{**defaults, **fields})
+def _verdict(effect: str, delta_bic: float, after: float | None, **fields) -> Finding:
+    """A made-up verdict of round 1, refitted, not accepted: test RMSE 1.0 K → ``after``."""
+    fields = {"rmse_test_after": after, "delta_bic": delta_bic, "fit": object(), **fields}
+    return _finding(effect, False, **fields)
 
 
 def _state(*verdicts: Finding) -> tuple[SimpleNamespace, Selection]:

@@ -11,7 +11,8 @@
    to head on the folds picks the one accepted (the runner-up is reported with why it lost);
    where glazing is declared the opaque sun takes part only as a rival, named when it beats an
    effect that passes, never alone (``excess_sun``); repeat from the extended model until
-   nothing more is accepted;
+   nothing more is accepted — or, where the model then still forecasts no better than a naive
+   forecast, until a pair of effects that mask each other is not found either (``_masked_pair``);
 4. check every accepted finding backward: left out of the final model, does it still help across
    the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
