@@ -18,13 +18,10 @@ import numpy as np
 import pandas as pd
 
 from rcengine.columns import COLUMNS, Q_HVAC, T_IN
+from rcengine.diagnose.health import OnBound
 from rcengine.metrics import rmse
 from rcengine.parameter_set import ParameterSet
 from rcengine.record import MIN_T_IN_STD_K, t_in_spread
-
-# How close to zero, as a share of its upper bound, a non-negative parameter rests at zero: the
-# estimator's own margin for "on a bound" (``SearchSpace.at_bounds``, 1e-3 of the unit cube).
-ZERO_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -133,14 +130,15 @@ def _inside_bounds(pset: ParameterSet, limits: GateLimits) -> Check:
 
 
 def _resting_at_zero(pset: ParameterSet, name: str) -> bool:
-    """Whether ``name`` is a magnitude that cannot be negative (a gain, a g-value, an
-    absorptance, an air change rate: its lower bound is zero) and ended at zero. Such a parameter
-    says its effect was idle over the training days (no plug loads in a holiday fortnight, no
-    sun through a facade's glass), not that the search box pinned the fit."""
+    """Whether ``name``, one of the fit's parameters on a bound, is a magnitude that cannot be
+    negative (a gain, a g-value, an absorptance, an air change rate: its lower bound is zero) and
+    ended at zero (``OnBound.physical_none``). Such a parameter says its effect was idle over the
+    training days (no plug loads in a holiday fortnight, no sun through a facade's glass), not
+    that the search box pinned the fit."""
     parameter = pset.network.parameters.get(name)
-    if parameter is None or parameter.lower != 0.0:
+    if parameter is None:
         return False
-    return pset.values[name] <= ZERO_SHARE * parameter.upper
+    return OnBound(name, pset.values[name], parameter.lower, parameter.upper).physical_none
 
 
 def _predictions_plausible(predicted: np.ndarray) -> Check:

@@ -103,6 +103,11 @@ class FitQuality:
         name = min(self.naive, key=self.naive.__getitem__)
         return name, self.naive[name]
 
+    @property
+    def poor(self) -> bool:
+        """No better than the best naive forecast (False where there is none)."""
+        return bool(self.naive) and self.rmse >= self.best_naive[1]
+
 
 def same_time_earlier(
     measured: pd.Series, times: pd.DatetimeIndex, days: int, timezone: str
@@ -332,11 +337,9 @@ def _envelope_findings(
 
 def _fit_findings(model: str, quality: FitQuality, building: Building | None) -> list[str]:
     """A test error no better than the best naive forecast."""
-    if not quality.naive:
+    if not quality.poor:
         return []
     name, best = quality.best_naive
-    if quality.rmse < best:
-        return []
     of = f"a {building.floor_area:.0f} m² building" if building is not None else "this building"
     return [
         f"test RMSE {quality.rmse:.2g} K is poor for a {model} of {of}: no better than "

@@ -493,7 +493,7 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     alone (its margins, its ΔBIC, its magnitudes plausible in the joint fit), and each of the
     two, added last to the other, helps across the folds (the rule they would enter by). Returns
     whether it was kept; ``state`` then continues from the pair."""
-    near = _near_miss(problem, state) if _forecasts_poorly(problem, state.current) else None
+    near = _near_miss(problem, state) if _quality(problem, state.current).poor else None
     if near is None:
         return False
     problem.say(f"  nothing passed alone; trying {near.effect} with the next round's candidates")
@@ -524,12 +524,6 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     partner.detail["taken_with"] = near.effect
     vars(state).update(vars(trial))
     return True
-
-
-def _forecasts_poorly(problem: Problem, fit: Fit) -> bool:
-    """Whether ``fit`` forecasts the test half no better than the best naive forecast."""
-    quality = _quality(problem, fit)
-    return bool(quality.naive) and quality.rmse >= quality.best_naive[1]
 
 
 def _near_miss(problem: Problem, state: Selection) -> Finding | None:
