@@ -7,9 +7,9 @@ from types import SimpleNamespace
 import pytest
 
 from rcengine.building import Building
-from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose import DiagnoseSettings, diagnose, selection
 from rcengine.diagnose.report import Finding
-from rcengine.diagnose.selection import Selection, _near_miss
+from rcengine.diagnose.selection import Selection, _masked_pair, _near_miss
 from rcengine.io.timeseries import read_timeseries
 from tests.test_diagnose_evidence import _finding
 
@@ -44,6 +44,28 @@ def test_no_near_miss_where_nothing_helps_both_halves():
         _verdict("wind_infiltration", 3.0, 0.9), _verdict("sky_radiation", -40.0, 1.2)
     )
     assert _near_miss(problem, state) is None
+
+
+def test_a_refused_trial_is_written_on_the_near_miss(monkeypatch):
+    """Where the trial round accepts nothing on top of the near miss, the state is left as it
+    was and the near miss's own verdict says it was tried and why it was not kept."""
+    near = _verdict("ground_coupling", -60.0, 0.95, detail={})
+    problem, state = _state(near, _verdict("wind_infiltration", -20.0, 0.97))
+    problem.say = lambda message: None
+    monkeypatch.setattr(selection, "_quality", lambda problem, fit: SimpleNamespace(poor=True))
+    monkeypatch.setattr(Selection, "go_on_from", lambda self, fit, fold_fits=None: None)
+    monkeypatch.setattr(selection, "_extensions", lambda problem, state: ["a candidate"])
+    monkeypatch.setattr(selection, "_round", lambda problem, state, extensions: None)
+    assert not _masked_pair(problem, state)
+    assert state.accepted == [] and state.verdicts["ground_coupling"] is near
+    assert near.reason.endswith(
+        "; tried as a masked pair with the next round's candidates, not kept: no other "
+        "candidate passed on top of it"
+    )
+    assert near.detail["pair_trial"] == {
+        "with": None,
+        "outcome": "no other candidate passed on top of it",
+    }
 
 
 @pytest.mark.slow

@@ -497,6 +497,7 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     if near is None:
         return False
     problem.say(f"  nothing passed alone; trying {near.effect} with the next round's candidates")
+    alone_verdict = near
     near = replace(near, detail=dict(near.detail), absent=dict(near.absent))
     trial = state.trial()
     trial.take(near)
@@ -505,16 +506,21 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     extensions = _extensions(problem, trial)
     partner = _round(problem, trial, extensions) if extensions else None
     alone = state.verdicts.get(partner.effect) if partner is not None else None
-    if partner is None or alone is None or alone.fit is None:
-        return False
+    if partner is None:
+        return _refused(alone_verdict, None, "no other candidate passed on top of it")
+    if alone is None or alone.fit is None:
+        why = f"{partner.effect} has no fit of its own, alone, to judge the pair against"
+        return _refused(alone_verdict, partner.effect, why)
     on_top = _judge(problem, near.extension, alone.fit, partner.fit, near.screen, near.round)
     if not on_top.accepted:
         problem.say(f"  {near.effect} on top of {partner.effect} alone: {on_top.reason}")
-        return False
+        why = f"on top of {partner.effect} alone, {on_top.reason}"
+        return _refused(alone_verdict, partner.effect, why)
     trial.take(partner)
     _settle_sun(problem, trial, partner)
-    if not _each_added_last_helps(problem, trial, [near, partner]):
-        return False
+    failed = _fails_added_last(problem, trial, [near, partner])
+    if failed:
+        return _refused(alone_verdict, partner.effect, failed)
     near.accepted, near.short_of_bic = True, False
     near.reason = (
         f"accepted with {partner.effect}, which masked it ({near.reason}); on top of "
@@ -545,19 +551,34 @@ def _near_miss(problem: Problem, state: Selection) -> Finding | None:
     return min(near, key=lambda f: f.delta_bic, default=None)
 
 
-def _each_added_last_helps(problem: Problem, state: Selection, pair: list[Finding]) -> bool:
-    """Whether each finding of ``pair``, left out of ``state``'s model and added last again,
-    helps across the folds (``judge_folds``); the first keeps that evidence as its own (it was
-    judged against the model before the pair). True without folds."""
+def _fails_added_last(problem: Problem, state: Selection, pair: list[Finding]) -> str:
+    """What the folds say (``judge_folds``) of each finding of ``pair`` that, left out of
+    ``state``'s model and added last again, does not help across them: "" where both help (and
+    without folds). The first keeps that evidence as its own (it was judged against the model
+    before the pair)."""
     if not problem.folds:
-        return True
+        return ""
     _, evidence = _without_each(problem, state, pair)
     verdicts = [judge_folds(ev, problem.settings.fold_rule) for ev in evidence]
     for finding, (_, text) in zip(pair, verdicts, strict=True):
         problem.say(f"  {finding.effect} added last to the pair: {text}")
     pair[0].evidence = evidence[0]
     pair[0].folds = evidence[0].to_dict(problem.folds, problem.building.location.timezone)
-    return all(ok for ok, _ in verdicts)
+    return "; ".join(
+        f"{finding.effect} added last to the pair: {text}"
+        for finding, (ok, text) in zip(pair, verdicts, strict=True)
+        if not ok
+    )
+
+
+def _refused(near: Finding, partner: str | None, why: str) -> bool:
+    """Record on the near miss's own verdict that it was tried as a masked pair (with
+    ``partner``, the effect the trial round accepted on top of it) and why the pair was not
+    kept, so the report shows the step was taken. Returns False: nothing was kept."""
+    near.detail["pair_trial"] = {"with": partner, "outcome": why}
+    tried = f"with {partner}" if partner else "with the next round's candidates"
+    near.reason += f"; tried as a masked pair {tried}, not kept: {why}"
+    return False
 
 
 def _settle_sun(problem: Problem, state: Selection, finding: Finding) -> None:
