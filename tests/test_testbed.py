@@ -35,6 +35,7 @@ from scripts.energyplus.testbed import (
     SEALED_SEEDS,
     SEALED_SETS,
     SETS,
+    UNSEEN_CASES,
     draw_split,
     sealed_cases,
 )
@@ -176,6 +177,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
     [
         ("testbed_fresh", FRESH_CASES, "medium"),
         *((name, cases, "drawn") for name, cases in SEALED_SETS.items()),
+        ("testbed_unseen", UNSEEN_CASES, "drawn"),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -199,7 +201,11 @@ def test_a_further_set_is_held_out_whole_and_covers_every_effect(
 
 
 @pytest.mark.parametrize(
-    "name", list(SEALED_SEEDS)[list(SEALED_SEEDS).index(FIRST_SET_WITH_HEATING_FLOOR) :]
+    "name",
+    [
+        *list(SEALED_SEEDS)[list(SEALED_SEEDS).index(FIRST_SET_WITH_HEATING_FLOOR) :],
+        "testbed_unseen",
+    ],
 )
 def test_every_case_of_a_newer_set_heats(project_data: Path, name: str) -> None:
     """From the eleventh sealed set on, every case heats at least the floor per m² of floor."""

@@ -23,6 +23,17 @@ Constructions are listed outside → inside; U-values include ISO 6946 films.
   per m²). Ribbon windows of double low-e glazing (U 1.8, g 0.60). 0.3 ACH; 1 person per
   12 m², lights 9 W/m². Heating to 21 °C on weekdays 06:00–19:00, 16 °C otherwise.
 
+* ``school`` (``UNSEEN_ARCHETYPES``: never drawn into the main bed or a sealed set, kept for a
+  set of its own, ``testbed_unseen``) — single-storey school, 36 m × 16 m × 3.2 m, a row of
+  classrooms to the south and one to the north (576 m², 2 zones): red-brick cavity wall with
+  100 mm mineral wool and a concrete-block inner leaf (U 0.30), dark membrane roof on 180 mm
+  board and timber deck (U 0.18), a concrete floor over a heated basement (adiabatic), a
+  block corridor wall between the rows and 0.8 m² of light partitions and furniture per m².
+  Solar-control double glazing (U 1.6, g 0.45) from 0.9 to 2.8 m. 0.6 ACH; 1 person per 8 m²
+  of gross floor on school hours (08:00–15:00, lunch at half), lights 10 W/m². Heating to
+  20 °C on weekdays 06:00–16:00, 15 °C otherwise. Its schedules, shape and constructions were
+  chosen after the diagnosis was built, to judge it on a building type it was never tuned on.
+
 Every variant has windows on every facade (``Variant.wwr``), constant infiltration, metered
 people and lights on the office profiles, a heater of limited capacity
 (``Variant.heating_capacities``: ``capacity_factor`` × the design heat loss at the EPW's 99.6 %
@@ -40,15 +51,21 @@ from typing import Any
 from .idf import idf_object
 from .library import (
     BRICK_100,
+    CONCRETE_BLOCK_200,
     GYPSUM_19,
     HEAVY_CONCRETE_100,
     HEAVY_CONCRETE_200,
+    OFF_DAY,
+    OFFICE_LIGHTING,
+    OFFICE_OCCUPANCY,
     PARTITION,
     WALL_AIR_SPACE,
     WOOD_25,
     Construction,
     Material,
     SimpleGlazing,
+    WeekSchedule,
+    day_profile,
 )
 from .shoebox import SOIL_1000
 
@@ -67,6 +84,7 @@ SOLID_BRICK_240 = Material("Solid brick 240mm", 0.24, 0.72, 1800.0, 840.0, "Roug
 RENDER = Material("Render 15mm", 0.015, 0.87, 1800.0, 840.0, "Rough")
 PLASTER = Material("Gypsum plaster 15mm", 0.015, 0.4, 1000.0, 1000.0, "Smooth")
 SCREED_50 = Material("Cement screed 50mm", 0.05, 1.4, 2000.0, 1000.0)
+MINERAL_WOOL_100 = Material("Mineral wool 100mm", 0.1, 0.036, 30.0, 840.0)
 
 # --- constructions (outside → inside) -------------------------------------------------------
 CLADDING = WOOD_25.surface("Timber cladding painted", 0.9, 0.45)
@@ -92,6 +110,15 @@ DECK_ROOF = Construction(
     "Metal deck roof", (MEMBRANE.surface("Membrane grey", 0.9, 0.6), BOARD_180, METAL)
 )
 EXPOSED_SLAB = Construction("Exposed concrete slab", (HEAVY_CONCRETE_200, SCREED_50))
+CAVITY_WALL = Construction(
+    "Brick cavity wall",
+    (BRICK_100.surface("Brick red", 0.9, 0.65), MINERAL_WOOL_100, CONCRETE_BLOCK_200, PLASTER),
+)
+TIMBER_DECK_ROOF = Construction(
+    "Timber deck roof",
+    (MEMBRANE.surface("Membrane dark", 0.9, 0.75), BOARD_180, WOOD_25, GYPSUM_19),
+)
+BLOCK_PARTITION = Construction("Block partition", (PLASTER, CONCRETE_BLOCK_200, PLASTER))
 
 # --- constructions of the concealed effects -------------------------------------------------
 # Dark facades of little insulation: the sun they absorb reaches the room (sol-air).
@@ -130,7 +157,8 @@ class Archetype:
     north); ``mass_per_floor``: internal-mass area per floor area [m²/m²]; sill / head: window
     heights above the storey floor [m]; ``m2_per_person`` [m²]; lights [W/m²]; infiltration
     [1/h]; setpoints [°C]; heated_hours: weekday hours of the occupied setpoint (civil time);
-    capacity_factor: heater size / design heat loss [-]."""
+    capacity_factor: heater size / design heat loss [-]; occupancy, lighting: the metered
+    people's and lights' profiles (shares of their peak)."""
 
     name: str
     summary: str
@@ -158,6 +186,8 @@ class Archetype:
     setback: float
     heated_hours: tuple[int, int]
     capacity_factor: float
+    occupancy: WeekSchedule = OFFICE_OCCUPANCY
+    lighting: WeekSchedule = OFFICE_LIGHTING
 
     @property
     def floor_area(self) -> float:
@@ -209,6 +239,57 @@ LIGHT, HEAVY, OPEN_PLAN = (
     Archetype(**{field: column[i] for field, column in _TABLE.items()}) for i in range(3)
 )
 ARCHETYPES = {a.name: a for a in (LIGHT, HEAVY, OPEN_PLAN)}
+
+SCHOOL_OCCUPANCY = WeekSchedule(
+    weekday=day_profile(
+        ("07:30", "08:00", "12:00", "13:00", "15:00", "17:00", "24:00"),
+        (0.0, 0.3, 0.95, 0.5, 0.95, 0.1, 0.0),
+    ),
+    saturday=OFF_DAY,
+    sunday=OFF_DAY,
+)
+SCHOOL_LIGHTING = WeekSchedule(
+    weekday=day_profile(("07:00", "08:00", "15:00", "17:00", "24:00"), (0.02, 0.5, 0.9, 0.3, 0.02)),
+    saturday=(("24:00", 0.02),),
+    sunday=(("24:00", 0.02),),
+)
+SCHOOL = Archetype(
+    name="school",
+    summary="Single-storey brick school, 576 m² in two rows of classrooms",
+    zone_name="Classrooms",
+    width=36.0,
+    depth=16.0,
+    storey_height=3.2,
+    storeys=1,
+    rows=2,
+    wall=CAVITY_WALL,
+    roof=TIMBER_DECK_ROOF,
+    floor=CONCRETE_FLOOR,
+    floor_boundary="Adiabatic",
+    intermediate_floor=None,
+    partition=BLOCK_PARTITION,
+    internal_mass=PARTITION,
+    mass_per_floor=0.8,
+    glazing=SimpleGlazing("Double solar-control U1.6", 1.6, 0.45, 0.6),
+    sill=0.9,
+    head=2.8,
+    m2_per_person=8.0,
+    lights_w_m2=10.0,
+    infiltration_ach=0.6,
+    occupied_setpoint=20.0,
+    setback=15.0,
+    heated_hours=(6, 16),
+    capacity_factor=1.4,
+    occupancy=SCHOOL_OCCUPANCY,
+    lighting=SCHOOL_LIGHTING,
+)
+# Archetypes kept out of every draw of the main bed and the sealed sets (``ARCHETYPES``).
+UNSEEN_ARCHETYPES = {SCHOOL.name: SCHOOL}
+
+
+def archetype_named(name: str) -> Archetype:
+    """The archetype called ``name``, drawn or unseen."""
+    return {**ARCHETYPES, **UNSEEN_ARCHETYPES}[name]
 
 
 @dataclass(frozen=True)

@@ -31,8 +31,6 @@ from .idf import (
     window_surface,
 )
 from .library import (
-    OFFICE_LIGHTING,
-    OFFICE_OCCUPANCY,
     Construction,
     Material,
     SimpleGlazing,
@@ -288,8 +286,8 @@ class Variant:
             header(self.archetype.name, site, period, timesteps_per_hour=4),
             calendar.objects(),
             materials_and_constructions(self._constructions()),
-            week_schedule("Occupancy", OFFICE_OCCUPANCY),
-            week_schedule("Lighting", OFFICE_LIGHTING),
+            week_schedule("Occupancy", self.archetype.occupancy),
+            week_schedule("Lighting", self.archetype.lighting),
             week_schedule("Heating Setpoint", self._setpoints(), "Any"),
             zones.activity_schedule(),
             zones.single_heating_control_schedule(),
@@ -427,6 +425,7 @@ class Variant:
                 "Heating Setpoint",
                 "Heating Availability",
                 name=f"{z.name} Radiant Floor",
+                with_source=z == self.zones()[0],
             )
         return zones.ideal_loads_heating(
             z.name, "Heating Setpoint", "Heating Availability", capacity_w

@@ -209,22 +209,28 @@ def radiant_floor_heating(
     setpoint_schedule: str,
     availability_schedule: str,
     name: str = "Radiant Floor",
+    with_source: bool = True,
 ) -> str:
     """Electric radiant floor heating ``surface`` (whose ``construction`` holds the mat after
     layer ``source_after_layer``), at most ``capacity_w``, proportional on the air temperature
-    over 2 K around the setpoint (full power 1 K below it, none 1 K above). [W]"""
+    over 2 K around the setpoint (full power 1 K below it, none 1 K above). [W]
+
+    ``with_source``: whether to declare the construction's heat source; EnergyPlus takes one
+    declaration per construction, so the radiant floors of further zones sharing it leave it
+    out."""
+    source = idf_object(
+        "ConstructionProperty:InternalHeatSource",
+        f"{name} Source",
+        construction,
+        source_after_layer,
+        source_after_layer,
+        1,
+        0.15,
+        0.0,
+    )
     return "".join(
         [
-            idf_object(
-                "ConstructionProperty:InternalHeatSource",
-                f"{name} Source",
-                construction,
-                source_after_layer,
-                source_after_layer,
-                1,
-                0.15,
-                0.0,
-            ),
+            source if with_source else "",
             _equipment(zone_name, "ZoneHVAC:LowTemperatureRadiant:Electric", name),
             idf_object(
                 "ZoneHVAC:LowTemperatureRadiant:Electric",
