@@ -20,7 +20,7 @@ from rcengine.diagnose.folds import (
     judge_folds,
     rolling_folds,
 )
-from rcengine.diagnose.report import Finding, explain
+from rcengine.diagnose.report import Finding, explain, verdict
 from rcengine.diagnose.selection import Selection, _backward, _one_version_each, _recheck_repair
 from rcengine.diagnose.settings import split_time
 from rcengine.models import get_model
@@ -28,6 +28,7 @@ from rcengine.network import Parameter, RCNetwork
 from rcengine.signals import SignalOptions
 
 from .synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from .test_diagnose_evidence import CRIPPLED
 
 TZ = "Europe/Rome"
 DAY = pd.Timedelta(days=1)
@@ -368,18 +369,32 @@ def test_a_repair_the_bounds_still_need_stays_but_after_the_findings(monkeypatch
     assert state.current == "final" and not state.verdicts
 
 
-@pytest.mark.parametrize(
-    ("without", "later"),
-    [
-        ([0.8, 0.7, 0.9, 0.8], ("sky",)),  # helps in every fold: a storage is missing
-        ([0.51, 0.5, 0.49, 0.51], ()),  # nothing found after it: not checked
-    ],
-)
-def test_a_repair_that_helps_stays_first(monkeypatch, without, later):
-    state = _repair_check(without, True, monkeypatch, later)
+@pytest.mark.parametrize("later", [("sky",), ()])
+def test_a_repair_that_helps_stays_first(monkeypatch, later):
+    # Without it every fold is forecast worse: a storage is missing, found alone or not.
+    state = _repair_check([0.8, 0.7, 0.9, 0.8], True, monkeypatch, later)
     assert [f.effect for f in state.accepted] == ["thermal_mass", *later]
     assert state.current == "final" and not state.verdicts
-    assert state.calls == ([["thermal_mass"]] if later else [])
+    assert state.calls == [["thermal_mass"]]
+
+
+def test_a_repair_alone_that_the_folds_do_not_need_is_not_the_answer(monkeypatch):
+    # Nothing found after it, and the model without it is inadequate again, but the folds are
+    # forecast as well without it: a storage is no more shown missing than on a null building,
+    # and being the first accepted finding would make it the report's answer.
+    state = _repair_check([0.51, 0.5, 0.49, 0.51], False, monkeypatch, later=())
+    assert state.accepted == []
+    dropped = state.verdicts["thermal_mass"]
+    assert not dropped.accepted and dropped.baseline_repair
+    assert dropped.reason.startswith("dropped: added last to the model it fails the folds")
+    assert dropped.reason.endswith("but the data do not show the storage missing")
+    assert dropped.backward["still_needed"] is False
+    assert dropped.backward["healthy_without"] is False
+    assert state.current == "final without thermal_mass"
+    assert verdict([dropped], CRIPPLED).endswith(
+        "— thermal_mass would heal its bounds but the data do not show it missing (dropped): "
+        "nothing missing"
+    )
 
 
 def test_the_backward_check_orders_the_findings_by_what_leaving_each_out_costs(monkeypatch):

@@ -371,11 +371,16 @@ def verdict(findings: list[Finding], health: Health | None) -> str:
             f"{found} (against the base model with {', '.join(repairs)}: without it, parameters "
             "rested on bounds the data do not press on)"
         )
-    dropped = [f.effect for f in findings if not f.accepted and f.baseline_repair]
+    dropped = [f for f in findings if not f.accepted and f.baseline_repair]
+    names = ", ".join(f.effect for f in dropped)
     if repairs:
         against = f"healthy with {', '.join(repairs)}, then {found}"
+    elif dropped and all((f.backward or {}).get("healthy_without", True) for f in dropped):
+        against = f"healthy once what it left out is in ({names} not needed): {found}"
     elif dropped:
-        against = f"healthy once what it left out is in ({', '.join(dropped)} not needed): {found}"
+        against = (
+            f"{names} would heal its bounds but the data do not show it missing (dropped): {found}"
+        )
     else:
         against = f"judged against it anyway: {found}"
     return f"base model inadequate: {'; '.join(health.reasons)} — {against}"

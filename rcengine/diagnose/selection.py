@@ -1029,32 +1029,35 @@ def _backward(problem: Problem, state: Selection) -> None:
 def _recheck_repair(problem: Problem, state: Selection) -> None:
     """The step taken to make the base model healthy, checked once the selection is over, like
     the findings in ``_backward``: a missing effect bends the base model's parameters too, and a
-    storage may then heal the bounds without being the physics left out. Where findings were
-    accepted after the step and it does not help across the folds of the final model (the rule
-    findings enter by), it is not what the data show missing: without it the final model
-    refitted from the final parameters is either healthy — the step stood in for what those
-    findings explain and is dropped — or still inadequate, and the step stays in the model as
-    the structure its bounds need, listed after the findings (``findings`` are ordered by
-    strength of evidence, CONTRACT §3). A step that helps stays first."""
+    storage may then heal the bounds without being the physics left out. A step that does not
+    help across the folds of the final model (the rule findings enter by) is not what the data
+    show missing. Without it the final model, refitted from the final parameters, is either
+    healthy — the step stood in for what the later findings explain and is dropped — or still
+    inadequate: the step then stays in the model as the structure its bounds need, listed after
+    the later findings (``findings`` are ordered by strength of evidence, CONTRACT §3), and
+    where no finding came after it, it is dropped as well, since the first accepted finding is
+    the report's answer to what was left out and the data do not show the storage missing. A
+    step that helps stays first."""
     repair = next((f for f in state.accepted if f.baseline_repair), None)
-    if repair is None or len(state.accepted) < 2 or not problem.folds:
+    if repair is None or not problem.folds:
         return
     problem.say(f"  checking whether the final model still needs {repair.effect}")
     ((fit, fold_fits),), (evidence,) = _without_each(problem, state, [repair])
     _, health = _health(problem, fit)
     helps, text = judge_folds(evidence, problem.settings.fold_rule)
+    later = len(state.accepted) > 1
     repair.backward = _added_last(
         problem,
         evidence,
         text,
-        still_needed=helps or not health.healthy,
+        still_needed=helps or (later and not health.healthy),
         helps_on_folds=helps,
         healthy_without=health.healthy,
     )
     if helps:
         return
     state.accepted.remove(repair)
-    if not health.healthy:
+    if later and not health.healthy:
         repair.reason += (
             f"; added last to the final model it fails the folds ({text}): kept for the base "
             "model's bounds, listed after the findings the data show missing"
@@ -1064,6 +1067,9 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
     repair.accepted = False
     repair.reason = (
         f"dropped once the later findings were in: without it the model is healthy; {text}"
+        if health.healthy
+        else f"dropped: added last to the model it fails the folds ({text}); without it the "
+        "base model rests on its bounds again, but the data do not show the storage missing"
     )
     state.verdicts[repair.effect] = repair
     state.go_on_from(fit, fold_fits)
