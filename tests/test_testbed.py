@@ -26,7 +26,8 @@ from benchmarks.diagnose_testbed import (
 from benchmarks.diagnosis_reliability import figures, precision_table, recall_table, results_of
 from rcengine.building import Building
 from rcengine.io.timeseries import read_timeseries
-from scripts.energyplus.archetypes import ARCHETYPES
+from scripts.energyplus.archetypes import ARCHETYPES, archetype_named
+from scripts.energyplus.library import OFF_DAY, OFFICE_OCCUPANCY
 from scripts.energyplus.testbed import (
     CASES,
     FIRST_SET_WITH_HEATING_FLOOR,
@@ -268,6 +269,29 @@ def test_heavy_archetype_has_four_zones_on_two_storeys() -> None:
     assert len(zones) == 4
     assert {z.box.z0 for z in zones} == {0.0, ARCHETYPES["heavy"].storey_height}
     assert sum(z.box.floor_area for z in zones) == pytest.approx(ARCHETYPES["heavy"].floor_area)
+
+
+def test_the_unseen_school_is_in_no_other_draw_and_keeps_its_own_schedules() -> None:
+    """Two zones on one storey, pupils only on school hours; no main-bed or sealed case uses it,
+    and its set is drawn over it alone."""
+    school = archetype_named("school")
+    zones = Variant(school).zones()
+    assert len(zones) == 2 and {z.box.z0 for z in zones} == {0.0}
+    assert school.occupancy.saturday == OFF_DAY and school.occupancy != OFFICE_OCCUPANCY
+    assert "school" not in ARCHETYPES
+    drawn = [*CASES, *FRESH_CASES, *(c for cases in SEALED_SETS.values() for c in cases)]
+    assert all(c.archetype != "school" for c in drawn)
+    assert {c.archetype for c in UNSEEN_CASES} == {"school"}
+
+
+def test_a_radiant_floor_over_two_zones_declares_its_heat_source_once() -> None:
+    """EnergyPlus takes one heat source per construction: the second zone's floor shares it."""
+    radiant = Variant(archetype_named("school"), radiant_screed_mm=80)
+    heating = "".join(radiant._heating(z, 1000.0) for z in radiant.zones())
+    assert heating.count("ConstructionProperty:InternalHeatSource") == 1
+    assert [
+        f"{z.name} Radiant Floor,\n    Heating Availability" in heating for z in radiant.zones()
+    ] == [True, True]
 
 
 # --- benchmark scoring on made-up reports -----------------------------------------------------
