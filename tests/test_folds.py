@@ -378,6 +378,18 @@ def test_a_repair_that_helps_stays_first(monkeypatch, later):
     assert state.calls == [["thermal_mass"]]
 
 
+def test_a_repair_alone_that_the_folds_do_not_need_and_the_model_does_without_is_dropped(
+    monkeypatch,
+):
+    state = _repair_check([0.51, 0.5, 0.49, 0.51], True, monkeypatch, later=())
+    dropped = state.verdicts["thermal_mass"]
+    assert state.accepted == [] and not dropped.accepted
+    assert dropped.reason.endswith("without it the base model is healthy, refitted")
+    assert verdict([dropped], CRIPPLED).endswith(
+        "— healthy without thermal_mass once refitted (not needed): nothing missing"
+    )
+
+
 def test_a_repair_alone_that_the_folds_do_not_need_is_not_the_answer(monkeypatch):
     # Nothing found after it, and the model without it is inadequate again, but the folds are
     # forecast as well without it: a storage is no more shown missing than on a null building,

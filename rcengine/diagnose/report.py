@@ -376,7 +376,11 @@ def verdict(findings: list[Finding], health: Health | None) -> str:
     if repairs:
         against = f"healthy with {', '.join(repairs)}, then {found}"
     elif dropped and all((f.backward or {}).get("healthy_without", True) for f in dropped):
-        against = f"healthy once what it left out is in ({names} not needed): {found}"
+        against = (
+            f"healthy once what it left out is in ({names} not needed): {found}"
+            if missing
+            else f"healthy without {names} once refitted (not needed): {found}"
+        )
     elif dropped:
         against = (
             f"{names} would heal its bounds but the data do not show it missing (dropped): {found}"

@@ -1065,12 +1065,20 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
         state.accepted.append(repair)
         return
     repair.accepted = False
-    repair.reason = (
-        f"dropped once the later findings were in: without it the model is healthy; {text}"
-        if health.healthy
-        else f"dropped: added last to the model it fails the folds ({text}); without it the "
-        "base model rests on its bounds again, but the data do not show the storage missing"
-    )
+    if health.healthy and later:
+        repair.reason = (
+            f"dropped once the later findings were in: without it the model is healthy; {text}"
+        )
+    else:
+        without = (
+            "is healthy, refitted"
+            if health.healthy
+            else "rests on its bounds again, but the data do not show the storage missing"
+        )
+        repair.reason = (
+            f"dropped: added last to the model it fails the folds ({text}); without it the "
+            f"base model {without}"
+        )
     state.verdicts[repair.effect] = repair
     state.go_on_from(fit, fold_fits)
 
