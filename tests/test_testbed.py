@@ -36,7 +36,7 @@ from scripts.energyplus.testbed import (
     SEALED_SEEDS,
     SEALED_SETS,
     SETS,
-    UNSEEN_CASES,
+    UNSEEN_SETS,
     draw_split,
     sealed_cases,
 )
@@ -178,7 +178,7 @@ def test_testbed_fits_in_the_repository(any_set: tuple[Path, list[dict]]) -> Non
     [
         ("testbed_fresh", FRESH_CASES, "medium"),
         *((name, cases, "drawn") for name, cases in SEALED_SETS.items()),
-        ("testbed_unseen", UNSEEN_CASES, "drawn"),
+        *((name, cases, "drawn") for name, cases in UNSEEN_SETS.items()),
     ],
 )
 def test_a_further_set_is_held_out_whole_and_covers_every_effect(
@@ -205,7 +205,7 @@ def test_a_further_set_is_held_out_whole_and_covers_every_effect(
     "name",
     [
         *list(SEALED_SEEDS)[list(SEALED_SEEDS).index(FIRST_SET_WITH_HEATING_FLOOR) :],
-        "testbed_unseen",
+        *UNSEEN_SETS,
     ],
 )
 def test_every_case_of_a_newer_set_heats(project_data: Path, name: str) -> None:
@@ -281,7 +281,7 @@ def test_the_unseen_school_is_in_no_other_draw_and_keeps_its_own_schedules() -> 
     assert "school" not in ARCHETYPES
     drawn = [*CASES, *FRESH_CASES, *(c for cases in SEALED_SETS.values() for c in cases)]
     assert all(c.archetype != "school" for c in drawn)
-    assert {c.archetype for c in UNSEEN_CASES} == {"school"}
+    assert all({c.archetype for c in cases} == {"school"} for cases in UNSEEN_SETS.values())
 
 
 def test_a_radiant_floor_over_two_zones_declares_its_heat_source_once() -> None:
