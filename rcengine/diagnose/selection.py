@@ -505,9 +505,9 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     trial.round_no += 1
     extensions = _extensions(problem, trial)
     partner = _round(problem, trial, extensions) if extensions else None
-    alone = state.verdicts.get(partner.effect) if partner is not None else None
     if partner is None:
         return _refused(alone_verdict, None, "no other candidate passed on top of it")
+    alone = state.verdicts.get(partner.effect)
     if alone is None or alone.fit is None:
         why = f"{partner.effect} has no fit of its own, alone, to judge the pair against"
         return _refused(alone_verdict, partner.effect, why)
@@ -1046,18 +1046,19 @@ def _recheck_repair(problem: Problem, state: Selection) -> None:
     _, health = _health(problem, fit)
     helps, text = judge_folds(evidence, problem.settings.fold_rule)
     later = len(state.accepted) > 1
+    kept_for_bounds = later and not health.healthy
     repair.backward = _added_last(
         problem,
         evidence,
         text,
-        still_needed=helps or (later and not health.healthy),
+        still_needed=helps or kept_for_bounds,
         helps_on_folds=helps,
         healthy_without=health.healthy,
     )
     if helps:
         return
     state.accepted.remove(repair)
-    if later and not health.healthy:
+    if kept_for_bounds:
         repair.reason += (
             f"; added last to the final model it fails the folds ({text}): kept for the base "
             "model's bounds, listed after the findings the data show missing"

@@ -23,8 +23,8 @@ Constructions are listed outside → inside; U-values include ISO 6946 films.
   per m²). Ribbon windows of double low-e glazing (U 1.8, g 0.60). 0.3 ACH; 1 person per
   12 m², lights 9 W/m². Heating to 21 °C on weekdays 06:00–19:00, 16 °C otherwise.
 
-* ``school`` (``UNSEEN_ARCHETYPES``: never drawn into the main bed or a sealed set, kept for a
-  set of its own, ``testbed_unseen``) — single-storey school, 36 m × 16 m × 3.2 m, a row of
+* ``school`` (``UNSEEN_ARCHETYPES``: never drawn into the main bed or a sealed set, kept for
+  sets of its own, ``testbed.UNSEEN_SETS``) — single-storey school, 36 m × 16 m × 3.2 m, a row of
   classrooms to the south and one to the north (576 m², 2 zones): red-brick cavity wall with
   100 mm mineral wool and a concrete-block inner leaf (U 0.30), dark membrane roof on 180 mm
   board and timber deck (U 0.18), a concrete floor over a heated basement (adiabatic), a
@@ -35,9 +35,10 @@ Constructions are listed outside → inside; U-values include ISO 6946 films.
   chosen after the diagnosis was built, to judge it on a building type it was never tuned on.
 
 Every variant has windows on every facade (``Variant.wwr``), constant infiltration, metered
-people and lights on the office profiles, a heater of limited capacity
-(``Variant.heating_capacities``: ``capacity_factor`` × the design heat loss at the EPW's 99.6 %
-heating design temperature) and a holiday closure with the heating off (``Calendar``).
+people and lights on its archetype's profiles (the office's; the school's own), a heater of
+limited capacity (``Variant.heating_capacities``: ``capacity_factor`` × the design heat loss at
+the EPW's 99.6 % heating design temperature) and a holiday closure with the heating off
+(``Calendar``).
 Schedules run on civil time: EnergyPlus shifts them by an hour on its daylight-saving days
 (whole days, the change days included) while its clock and outputs stay on standard time.
 """
@@ -285,11 +286,12 @@ SCHOOL = Archetype(
 )
 # Archetypes kept out of every draw of the main bed and the sealed sets (``ARCHETYPES``).
 UNSEEN_ARCHETYPES = {SCHOOL.name: SCHOOL}
+_EVERY_ARCHETYPE = {**ARCHETYPES, **UNSEEN_ARCHETYPES}
 
 
 def archetype_named(name: str) -> Archetype:
     """The archetype called ``name``, drawn or unseen."""
-    return {**ARCHETYPES, **UNSEEN_ARCHETYPES}[name]
+    return _EVERY_ARCHETYPE[name]
 
 
 @dataclass(frozen=True)
