@@ -10,6 +10,8 @@ import pytest
 
 from rcengine.diagnose.candidates import SOIL_LAYER_DEPTH_ISO, Context, Extension
 from rcengine.diagnose.plausibility import assess
+from rcengine.diagnose.selection import refit_preset
+from rcengine.diagnose.settings import DiagnoseSettings
 from rcengine.estimation import Estimator
 from rcengine.models import get_model
 from rcengine.signals import SignalOptions, prepare
@@ -83,3 +85,18 @@ def test_iso_52016_s_fixed_half_metre_cannot_carry_a_deeper_soil(slab_record):
     fixed = _fit(layered, data, d_soil=SOIL_LAYER_DEPTH_ISO)
     assert free.rmse_ < 1.2 * NOISE_K
     assert fixed.rmse_ > 3.0 * free.rmse_, (fixed.rmse_, free.rmse_)
+
+
+def test_a_refit_that_adds_a_state_takes_the_longer_search():
+    """The layer of soil is a capacitor the model did not have: its refit takes the structural
+    preset's longer genetic search, as the thermal mass and the emitter do; the floor straight
+    onto the soil adds only inputs and takes the short one."""
+    frame = weather_and_gains(10, start="2016-11-01")
+    network = get_model("basic", BUILDING, frame.columns)
+    data = prepare(frame.assign(t_in=20.0), BUILDING, network.compile().input_names)
+    context = Context(network, BUILDING, data, SignalOptions(), TRUTH_BASIC, np.zeros(len(data)))
+    settings = DiagnoseSettings()
+    assert settings.structural_preset != settings.preset
+    layered, bare = (ground_version(context, layer) for layer in (True, False))
+    assert refit_preset(settings, layered, network) == settings.structural_preset
+    assert refit_preset(settings, bare, network) == settings.preset
