@@ -450,7 +450,7 @@ def refit_preset(
     The soil's capacity under a slab trades against the base model's own stores: on the
     thirty-seventh sealed set's bare open-plan slab in Golden, the short search read the ground
     at 12.5 °C, U 1.9 W/(m²K), and forecast the test half 18 % worse; the longer one read 7.9 °C
-    at U 1.2 (the soil 8.0 °C over those months, the floor 1.08) and 23 % better."""
+    at U 1.2 (the soil 9.1 °C over those months, the floor 1.08) and 23 % better."""
     adds_state = len(ext.network.capacitors) > len(current.capacitors)
     return settings.structural_preset if ext.structural or adds_state else settings.preset
 
