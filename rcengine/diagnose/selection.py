@@ -16,12 +16,13 @@
 4. check every accepted finding backward: left out of the final model, does it still help across
    the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
-Before any of this the base model (fitted within bounds derived from the building) is checked for
-health (``health``): against a crippled base model any flexible extension "wins". A base model
-that is inadequate, or rests a parameter on a bound the data do not press on (healthy, but
-perhaps of too low an order), is given the structural ``thermal_mass`` step, taken when it leaves
-no parameter on a bound; otherwise the candidates are still judged against the base model, and
-the verdict says whether it is inadequate.
+Before any of this the base model (fitted within bounds derived from the building) is given the
+lights' convective share where it settles inside the range luminaires span (``metered``), and
+checked for health (``health``): against a crippled base model any flexible extension "wins".
+A base model that is inadequate, or rests a parameter on a bound the data do not press on
+(healthy, but perhaps of too low an order), is given the structural ``thermal_mass`` step, taken
+when it leaves no parameter on a bound; otherwise the candidates are still judged against the
+base model, and the verdict says whether it is inadequate.
 """
 
 from __future__ import annotations
@@ -80,6 +81,7 @@ from rcengine.diagnose.health import (
     relaxed_bounds,
 )
 from rcengine.diagnose.locate import summarize
+from rcengine.diagnose.metered import F_LIGHT_AIR, LIGHT_CONVECTIVE_SHARE, with_lights_in_air
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
     Finding,
@@ -209,6 +211,7 @@ def _diagnose(
         frame = realigned(frame, clock.offset_h, timezone)
         problem, left_out = _problem(frame, building, settings, say)
         baseline = _baseline(problem, model)
+    baseline = _lights_placed(problem, baseline)
     quality, health = _health(problem, baseline, weigh_bounds=True)
     locate = _locate(baseline, building)
     state = Selection(baseline)
@@ -309,6 +312,33 @@ def _baseline(problem: Problem, model: str) -> Fit:
             network, options, split, settings.preset, settings.random_state, [fits[-1].params]
         ).run()
     return min(fits, key=lambda f: f.sse_train)
+
+
+def _lights_placed(problem: Problem, baseline: Fit) -> Fit:
+    """The base model with the lights' heat let into the air in the share a luminaire convects
+    (``metered``), where the fitted share settles inside its range, fits the training period
+    better and forecasts the test period no worse; otherwise the base model as fitted.
+
+    A share pressed to the most a luminaire convects says the occupied hours want more heat in
+    the air than the lights can give: heat missing, which the unmetered gain is there to judge,
+    so the base model is left as it was; a share of none is the model's own routing."""
+    network = with_lights_in_air(baseline.network)
+    if network is None:
+        return baseline
+    settings, options = problem.settings, baseline.options
+    low, high = LIGHT_CONVECTIVE_SHARE
+    starts = [{**baseline.params, F_LIGHT_AIR: f} for f in (low, (low + high) / 2)]
+    split = problem.split(network, options)
+    job = FitJob(network, options, split, settings.preset, settings.random_state, starts)
+    (placed,) = fit_many([job], settings.workers)
+    better = placed.sse_train < baseline.sse_train and placed.rmse_test <= baseline.rmse_test
+    if F_LIGHT_AIR in placed.at_bounds or not better:
+        return baseline
+    problem.say(
+        f"  the lights convect {placed.params[F_LIGHT_AIR]:.2f} of their heat into the air: "
+        f"test RMSE {baseline.rmse_test:.3f} → {placed.rmse_test:.3f} K"
+    )
+    return placed
 
 
 def _base_model(problem: Problem, model: str, bounds: str) -> RCNetwork:
