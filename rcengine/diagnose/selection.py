@@ -81,7 +81,12 @@ from rcengine.diagnose.health import (
     relaxed_bounds,
 )
 from rcengine.diagnose.locate import summarize
-from rcengine.diagnose.metered import F_LIGHT_AIR, LIGHT_CONVECTIVE_SHARE, with_lights_in_air
+from rcengine.diagnose.metered import (
+    F_LIGHT_AIR,
+    LIGHT_CONVECTIVE_SHARE,
+    MIN_SHARE_TAKEN,
+    with_lights_in_air,
+)
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
     Finding,
@@ -332,7 +337,8 @@ def _lights_placed(problem: Problem, baseline: Fit) -> Fit:
     job = FitJob(network, options, split, settings.preset, settings.random_state, starts)
     (placed,) = fit_many([job], settings.workers)
     better = placed.sse_train < baseline.sse_train and placed.rmse_test <= baseline.rmse_test
-    if F_LIGHT_AIR in placed.at_bounds or not better:
+    taken = placed.params[F_LIGHT_AIR] >= MIN_SHARE_TAKEN and F_LIGHT_AIR not in placed.at_bounds
+    if not (taken and better):
         return baseline
     problem.say(
         f"  the lights convect {placed.params[F_LIGHT_AIR]:.2f} of their heat into the air: "
