@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pandas as pd
 import pytest
 
@@ -18,6 +17,7 @@ from rcengine.diagnose.metered import (
 )
 from rcengine.models import get_model
 from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from tests.test_diagnose import _hidden_gain
 
 
 def _q_light_column(network, params: dict[str, float]) -> dict[str, float]:
@@ -85,8 +85,7 @@ def test_heat_truly_missing_is_still_named(hidden_gain_record_small):
 
 @pytest.fixture(scope="module")
 def hidden_gain_record_small() -> pd.DataFrame:
+    """``test_diagnose``'s record: its kitchen gain (``_hidden_gain``) added to the air."""
     inputs = weather_and_gains(21)
-    local = inputs.index.tz_convert(BUILDING.location.timezone)
-    kitchen = 15_000.0 * ((local.day_of_week < 5) & (local.hour >= 7) & (local.hour < 13))
-    truth = inputs.assign(q_occ=inputs["q_occ"] + np.asarray(kitchen))
+    truth = inputs.assign(q_occ=inputs["q_occ"] + _hidden_gain(inputs.index))
     return inputs.assign(t_in=basic_reference(truth, TRUTH_BASIC, (15.0, 19.0, 19.0)))

@@ -321,8 +321,9 @@ def _baseline(problem: Problem, model: str) -> Fit:
 
 def _lights_placed(problem: Problem, baseline: Fit) -> Fit:
     """The base model with the lights' heat let into the air in the share a luminaire convects
-    (``metered``), where the fitted share settles inside its range, fits the training period
-    better and forecasts the test period no worse; otherwise the base model as fitted.
+    (``metered``), where the fitted share settles inside its range at ``MIN_SHARE_TAKEN`` or
+    more, fits the training period better and forecasts the test period no worse; otherwise the
+    base model as fitted.
 
     A share pressed to the most a luminaire convects says the occupied hours want more heat in
     the air than the lights can give: heat missing, which the unmetered gain is there to judge,
