@@ -86,19 +86,25 @@ def basic_reference(
 
     ``solar`` names the columns heating the wall and the internal mass (ghi for Basic; the solar
     module's opaque and window signals for Sun). Inputs are held over each step (zero-order hold).
+    With ``r_mass_surf`` in ``p``, the radiant gains land on massless interior surfaces between
+    the air (through r_int) and the mass (through r_mass_surf), ISO 13790's surface node.
     """
     a_wall, a_floor, a_mass = 455.0, 1050.0, 560.0
     r_we, r_wi, r_i = p["r_wall_ext"] / a_wall, p["r_wall_int"] / a_wall, p["r_int"] / a_floor
+    r_ms = p.get("r_mass_surf", 0.0) / a_floor
     c_w, c_a, c_i = p["c_wall"] * a_wall, p["c_air"], p["c_int"] * a_mass
     cols = frame[["t_out", solar[0], solar[1], "q_hvac", "q_occ", "q_light"]].to_numpy()
 
     def rhs(_t: float, x: np.ndarray, row: np.ndarray) -> list[float]:
         t_w, t_a, t_i = x
         t_out, sol_w, sol_i, q_hvac, q_occ, q_light = row
+        radiant = p["alpha_int"] * sol_i + q_light
+        # The surfaces' balance: (t_a − t_s)/r_i + (t_i − t_s)/r_ms + radiant = 0.
+        t_s = (t_a / r_i + t_i / r_ms + radiant) / (1 / r_i + 1 / r_ms) if r_ms else t_i
+        into_mass = (t_s - t_i) / r_ms if r_ms else (t_a - t_i) / r_i + radiant
         d_w = ((t_out - t_w) / r_we + (t_a - t_w) / r_wi + p["alpha_wall"] * sol_w) / c_w
-        d_a = ((t_w - t_a) / r_wi + (t_i - t_a) / r_i + q_hvac + q_occ) / c_a
-        d_i = ((t_a - t_i) / r_i + p["alpha_int"] * sol_i + q_light) / c_i
-        return [d_w, d_a, d_i]
+        d_a = ((t_w - t_a) / r_wi + (t_s - t_a) / r_i + q_hvac + q_occ) / c_a
+        return [d_w, d_a, into_mass / c_i]
 
     x = np.array(x0, dtype=float)
     out = np.empty(len(frame))

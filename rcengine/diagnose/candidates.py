@@ -59,6 +59,7 @@ from rcengine.diagnose.response import (
     on_off_explainer,
     parameter_sensitivities,
 )
+from rcengine.diagnose.surfaces import SURFACE_NODE
 from rcengine.models.bounds import (
     R_SE_SHELTERED,
     RHO_CP_AIR,
@@ -180,6 +181,12 @@ def mass_node(net: RCNetwork) -> str:
     return inside[0] if inside else net.output
 
 
+def radiant_node(net: RCNetwork) -> str:
+    """Where radiant heat lands: the interior surfaces where the model has them (``surfaces``),
+    else the interior mass (``mass_node``)."""
+    return SURFACE_NODE if SURFACE_NODE in net.nodes else mass_node(net)
+
+
 def _has_wind(ctx: Context) -> bool:
     return WIND_SPEED in ctx.train.columns and bool(ctx.train[WIND_SPEED].notna().any())
 
@@ -236,7 +243,7 @@ def facade_areas(building: Building) -> dict[str, float]:
 
 def window_solar_gains(ctx: Context) -> Extension | Skipped:
     """Solar heat through glazing beyond what the declared windows admit at one g-value, per
-    orientation, absorbed by the interior mass:
+    orientation, absorbed where the radiant heat lands (``radiant_node``):
 
     - where windows are declared, an extra g-value g_k × the irradiance transmitted to them
       (``solar_window_<k>``: declared area × transmitted irradiance, incidence-angle modifier
@@ -259,7 +266,7 @@ def window_solar_gains(ctx: Context) -> Extension | Skipped:
     if not glazed and not undeclared:
         return Skipped(effect, "no windows or facades ('windows', 'walls') in the building JSON")
     facades = facade_areas(ctx.building)
-    target = mass_node(ctx.network)
+    target = radiant_node(ctx.network)
     net = ctx.network.copy(_name(ctx.network, effect))
     orientations, inputs = {}, []
     for key in [*glazed, *undeclared]:

@@ -100,6 +100,7 @@ from rcengine.diagnose.report import (
 )
 from rcengine.diagnose.screen import Screen, screen, screen_all
 from rcengine.diagnose.settings import DiagnoseSettings, split_time
+from rcengine.diagnose.surfaces import R_MASS_SURF, released_share, with_surface_node
 from rcengine.diagnose.whiteness import ljung_box
 from rcengine.estimation.presets import EstimatorSettings
 from rcengine.models import get_model
@@ -216,7 +217,7 @@ def _diagnose(
         frame = realigned(frame, clock.offset_h, timezone)
         problem, left_out = _problem(frame, building, settings, say)
         baseline = _baseline(problem, model)
-    baseline = _lights_placed(problem, baseline)
+    baseline = _lights_placed(problem, _surfaces_placed(problem, baseline))
     quality, health = _health(problem, baseline, weigh_bounds=True)
     locate = _locate(baseline, building)
     state = Selection(baseline)
@@ -319,6 +320,26 @@ def _baseline(problem: Problem, model: str) -> Fit:
     return min(fits, key=lambda f: f.sse_train)
 
 
+def _surfaces_placed(problem: Problem, baseline: Fit) -> Fit:
+    """The base model with its interior surfaces between the air and the mass (``surfaces``),
+    where r_mass_surf settles inside its range, fits the training period better and forecasts
+    the test period no worse; otherwise the base model as fitted (r_mass_surf at its least is the
+    thesis's routing)."""
+    network = with_surface_node(baseline.network)
+    if network is None:
+        return baseline
+    r_mass_surf = network.parameters[R_MASS_SURF]
+    low, high = r_mass_surf.lower, r_mass_surf.upper
+    placed = _refined_base(problem, baseline, network, R_MASS_SURF, (low, (low + high) / 2))
+    if placed is None or R_MASS_SURF in placed.at_bounds:
+        return baseline
+    problem.say(
+        f"  the interior surfaces give {released_share(placed.params):.2f} of the radiant heat "
+        f"to the air: test RMSE {baseline.rmse_test:.3f} → {placed.rmse_test:.3f} K"
+    )
+    return placed
+
+
 def _lights_placed(problem: Problem, baseline: Fit) -> Fit:
     """The base model with the lights' heat let into the air in the share a luminaire convects
     (``metered``), where the fitted share settles inside its range at ``MIN_SHARE_TAKEN`` or
@@ -331,21 +352,37 @@ def _lights_placed(problem: Problem, baseline: Fit) -> Fit:
     network = with_lights_in_air(baseline.network)
     if network is None:
         return baseline
-    settings, options = problem.settings, baseline.options
     low, high = LIGHT_CONVECTIVE_SHARE
-    starts = [{**baseline.params, F_LIGHT_AIR: f} for f in (low, (low + high) / 2)]
-    split = problem.split(network, options)
-    job = FitJob(network, options, split, settings.preset, settings.random_state, starts)
-    (placed,) = fit_many([job], settings.workers)
-    better = placed.sse_train < baseline.sse_train and placed.rmse_test <= baseline.rmse_test
-    taken = placed.params[F_LIGHT_AIR] >= MIN_SHARE_TAKEN and F_LIGHT_AIR not in placed.at_bounds
-    if not (taken and better):
+    placed = _refined_base(problem, baseline, network, F_LIGHT_AIR, (low, (low + high) / 2))
+    if placed is None:
+        return baseline
+    share = placed.params[F_LIGHT_AIR]
+    if share < MIN_SHARE_TAKEN or F_LIGHT_AIR in placed.at_bounds:
         return baseline
     problem.say(
-        f"  the lights convect {placed.params[F_LIGHT_AIR]:.2f} of their heat into the air: "
+        f"  the lights convect {share:.2f} of their heat into the air: "
         f"test RMSE {baseline.rmse_test:.3f} → {placed.rmse_test:.3f} K"
     )
     return placed
+
+
+def _refined_base(
+    problem: Problem,
+    baseline: Fit,
+    network: RCNetwork,
+    parameter: str,
+    starts: tuple[float, ...],
+) -> Fit | None:
+    """``network`` (the base model with one more ``parameter``) fitted from the base model's
+    optimum with ``parameter`` at each of ``starts``; the fit where it fits the training period
+    better and forecasts the test period no worse, else None."""
+    settings, options = problem.settings, baseline.options
+    begin = [{**baseline.params, parameter: value} for value in starts]
+    split = problem.split(network, options)
+    job = FitJob(network, options, split, settings.preset, settings.random_state, begin)
+    (placed,) = fit_many([job], settings.workers)
+    better = placed.sse_train < baseline.sse_train and placed.rmse_test <= baseline.rmse_test
+    return placed if better else None
 
 
 def _base_model(problem: Problem, model: str, bounds: str) -> RCNetwork:
