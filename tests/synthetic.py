@@ -115,6 +115,15 @@ def basic_reference(
     return out
 
 
+def heat_per_watt(network, params: dict[str, float], signal: str) -> dict[str, float]:
+    """The heat [W] one watt of ``signal`` puts on each state of ``network`` at ``params`` (its
+    massless nodes solved)."""
+    compiled = network.compile()
+    rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
+    column = rc.F[0, :, compiled.input_names.index(signal)]
+    return dict(zip(compiled.state_names, column, strict=True))
+
+
 # --- Sun model: real weather, geometric solar inputs ---------------------------------------------
 
 TRUTH_SUN = {**TRUTH_BASIC, "alpha_wall": 0.12, "alpha_int": 0.55}

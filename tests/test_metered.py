@@ -16,16 +16,14 @@ from rcengine.diagnose.metered import (
     with_lights_in_air,
 )
 from rcengine.models import get_model
-from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
+from tests.synthetic import (
+    BUILDING,
+    TRUTH_BASIC,
+    basic_reference,
+    heat_per_watt,
+    weather_and_gains,
+)
 from tests.test_diagnose import _hidden_gain
-
-
-def _q_light_column(network, params: dict[str, float]) -> dict[str, float]:
-    """The heat [W] one watt of q_light puts on each node."""
-    compiled = network.compile()
-    rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
-    column = rc.F[0, :, compiled.input_names.index("q_light")]
-    return dict(zip(compiled.state_names, column, strict=True))
 
 
 def test_the_lights_share_moves_heat_from_the_mass_to_the_air_and_keeps_it_whole():
@@ -35,7 +33,7 @@ def test_the_lights_share_moves_heat_from_the_mass_to_the_air_and_keeps_it_whole
     split = with_lights_in_air(base)
     assert split.parameters[F_LIGHT_AIR].lower == LIGHT_CONVECTIVE_SHARE[0]
     assert split.parameters[F_LIGHT_AIR].upper == LIGHT_CONVECTIVE_SHARE[1]
-    heat = _q_light_column(split, {**TRUTH_BASIC, F_LIGHT_AIR: 0.4})
+    heat = heat_per_watt(split, {**TRUTH_BASIC, F_LIGHT_AIR: 0.4}, "q_light")
     assert heat["air"] == pytest.approx(0.4)
     assert heat["int"] == pytest.approx(0.6)
     assert sum(heat.values()) == pytest.approx(1.0)

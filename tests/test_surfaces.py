@@ -17,15 +17,13 @@ from rcengine.diagnose.surfaces import (
     with_surface_node,
 )
 from rcengine.models import get_model
-from tests.synthetic import BUILDING, TRUTH_BASIC, basic_reference, weather_and_gains
-
-
-def _steady_heat(network, params: dict[str, float], signal: str) -> dict[str, float]:
-    """The heat [W] one watt of ``signal`` puts on each state, the massless nodes solved."""
-    compiled = network.compile()
-    rc = compiled.rc_matrices(compiled.as_theta(params)[:1])
-    column = rc.F[0, :, compiled.input_names.index(signal)]
-    return dict(zip(compiled.state_names, column, strict=True))
+from tests.synthetic import (
+    BUILDING,
+    TRUTH_BASIC,
+    basic_reference,
+    heat_per_watt,
+    weather_and_gains,
+)
 
 
 def test_the_surfaces_stand_between_the_air_and_the_mass():
@@ -39,7 +37,7 @@ def test_the_surfaces_stand_between_the_air_and_the_mass():
     assert {h.node for h in net.heat_inputs if h.signal in ("q_light", "ghi")} >= {SURFACE_NODE}
     assert not any(h.node == "int" for h in net.heat_inputs)
     params = {**TRUTH_BASIC, R_MASS_SURF: 0.45}
-    heat = _steady_heat(net, params, "q_light")
+    heat = heat_per_watt(net, params, "q_light")
     # r_mass_surf / (r_int + r_mass_surf) of a watt on the surfaces reaches the air at once.
     assert released_share(params) == pytest.approx(0.75)
     assert heat["air"] == pytest.approx(0.75) and heat["int"] == pytest.approx(0.25)
@@ -52,7 +50,10 @@ def test_surfaces_at_the_mass_temperature_are_the_thesis_routing():
     base = get_model("basic", BUILDING, frame.columns)
     net = with_surface_node(base)
     nested = {**TRUTH_BASIC, R_MASS_SURF: net.parameters[R_MASS_SURF].lower}
-    heat, thesis = _steady_heat(net, nested, "q_light"), _steady_heat(base, TRUTH_BASIC, "q_light")
+    heat, thesis = (
+        heat_per_watt(net, nested, "q_light"),
+        heat_per_watt(base, TRUTH_BASIC, "q_light"),
+    )
     assert heat["int"] == pytest.approx(thesis["int"], abs=0.01)
     assert heat["air"] == pytest.approx(thesis["air"], abs=0.01)
 
