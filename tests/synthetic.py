@@ -13,7 +13,7 @@ from scipy.integrate import solve_ivp
 from rcengine.building import Building
 from rcengine.diagnose.candidates import CANDIDATES, Context, Extension
 from rcengine.diagnose.fitting import fit_model, split_data
-from rcengine.diagnose.settings import split_time
+from rcengine.diagnose.settings import DiagnoseSettings, split_time
 from rcengine.models import get_model
 from rcengine.signals import SignalOptions
 
@@ -113,6 +113,22 @@ def basic_reference(
         sol = solve_ivp(rhs, (0.0, STEP_S), x, args=(row,), rtol=1e-10, atol=1e-10)
         x = sol.y[:, -1]
     return out
+
+
+def lit_office(days: int) -> pd.DataFrame:
+    """``weather_and_gains`` with 2 kW of occupants and 10 kW of lights over the lit hours: the
+    lights dominate the metered gains, so where their heat goes shows."""
+    inputs = weather_and_gains(days)
+    occupied = inputs["q_light"] > 0
+    return inputs.assign(q_occ=2_000.0 * occupied, q_light=10_000.0 * occupied)
+
+
+# One round judging the unmetered gain alone on a single 60/40 split, from one base-model search:
+# what the base-model steps' tests ask of a short synthetic record.
+UNMETERED_GAIN_ONLY = DiagnoseSettings(
+    train_fraction=0.6, evidence="split", baseline_starts=1, max_rounds=1,
+    effects=("unmetered_gains",),
+)  # fmt: skip
 
 
 def heat_per_watt(network, params: dict[str, float], signal: str) -> dict[str, float]:

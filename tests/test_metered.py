@@ -8,7 +8,7 @@ import json
 import pandas as pd
 import pytest
 
-from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose import diagnose
 from rcengine.diagnose.metered import (
     F_LIGHT_AIR,
     LIGHT_CONVECTIVE_SHARE,
@@ -19,8 +19,10 @@ from rcengine.models import get_model
 from tests.synthetic import (
     BUILDING,
     TRUTH_BASIC,
+    UNMETERED_GAIN_ONLY,
     basic_reference,
     heat_per_watt,
+    lit_office,
     weather_and_gains,
 )
 from tests.test_diagnose import _hidden_gain
@@ -50,18 +52,12 @@ def test_lights_that_convect_part_of_their_heat_are_not_an_unmetered_gain():
     all-radiant lights leave the occupied hours short of heat in the air, which an unmetered
     gain in step with the use would fill; the base model takes the lights' share, fitted at the
     0.6, and nothing is named."""
-    inputs = weather_and_gains(21)
-    occupied = inputs["q_light"] > 0
-    inputs = inputs.assign(q_occ=2_000.0 * occupied, q_light=10_000.0 * occupied)
+    inputs = lit_office(21)
     convected = 0.6 * inputs["q_light"]
     truth = inputs.assign(q_occ=inputs["q_occ"] + convected, q_light=inputs["q_light"] - convected)
     params = {**TRUTH_BASIC, "c_int": 1.0e6, "r_int": 0.3}
     record = inputs.assign(t_in=basic_reference(truth, params, (15.0, 19.0, 19.0)))
-    settings = DiagnoseSettings(
-        train_fraction=0.6, evidence="split", baseline_starts=1, max_rounds=1,
-        effects=("unmetered_gains",),
-    )  # fmt: skip
-    d = json.loads(diagnose(record, BUILDING, "basic", settings).to_json())
+    d = json.loads(diagnose(record, BUILDING, "basic", UNMETERED_GAIN_ONLY).to_json())
     assert d["baseline"]["parameters"][F_LIGHT_AIR] == pytest.approx(0.6, abs=0.03)
     assert d["baseline"]["rmse_test"] < 0.01
     assert not any(f["accepted"] for f in d["findings"])
@@ -71,11 +67,9 @@ def test_heat_truly_missing_is_still_named(hidden_gain_record_small):
     """A hidden kitchen gain on weekday mornings: the lights' share, pressed to the most a
     luminaire convects, cannot take it; the base model keeps its routing and the gain is found
     (``test_diagnose`` runs it in full)."""
-    settings = DiagnoseSettings(
-        train_fraction=0.6, evidence="split", baseline_starts=1, max_rounds=1,
-        effects=("unmetered_gains",),
-    )  # fmt: skip
-    d = json.loads(diagnose(hidden_gain_record_small, BUILDING, "basic", settings).to_json())
+    d = json.loads(
+        diagnose(hidden_gain_record_small, BUILDING, "basic", UNMETERED_GAIN_ONLY).to_json()
+    )
     (gain,) = [f for f in d["findings"] if f["effect"] == "unmetered_gains"]
     assert gain["accepted"], gain["reason"]
     assert F_LIGHT_AIR not in d["baseline"]["parameters"]

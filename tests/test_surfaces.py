@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from rcengine.diagnose import DiagnoseSettings, diagnose
+from rcengine.diagnose import diagnose
 from rcengine.diagnose.candidates import radiant_node
 from rcengine.diagnose.surfaces import (
     R_MASS_SURF,
@@ -20,8 +20,10 @@ from rcengine.models import get_model
 from tests.synthetic import (
     BUILDING,
     TRUTH_BASIC,
+    UNMETERED_GAIN_ONLY,
     basic_reference,
     heat_per_watt,
+    lit_office,
     weather_and_gains,
 )
 
@@ -64,16 +66,10 @@ def test_surfaces_that_give_radiant_heat_back_to_the_air_are_read_and_name_nothi
     thesis's routing leaves the sunny and occupied hours short of heat in the air, which an
     unmetered gain in step with the use would fill; the base model takes the surfaces and reads
     the share, and nothing is named."""
-    inputs = weather_and_gains(21)
-    occupied = inputs["q_light"] > 0
-    inputs = inputs.assign(q_occ=2_000.0 * occupied, q_light=10_000.0 * occupied)
+    inputs = lit_office(21)
     params = {**TRUTH_BASIC, "c_int": 1.0e6, "r_int": 0.2, R_MASS_SURF: 0.3}
     record = inputs.assign(t_in=basic_reference(inputs, params, (15.0, 19.0, 19.0)))
-    settings = DiagnoseSettings(
-        train_fraction=0.6, evidence="split", baseline_starts=1, max_rounds=1,
-        effects=("unmetered_gains",),
-    )  # fmt: skip
-    d = json.loads(diagnose(record, BUILDING, "basic", settings).to_json())
+    d = json.loads(diagnose(record, BUILDING, "basic", UNMETERED_GAIN_ONLY).to_json())
     fitted = d["baseline"]["parameters"]
     assert released_share(fitted) == pytest.approx(0.6, abs=0.05)
     assert d["baseline"]["rmse_test"] < 0.02

@@ -17,8 +17,9 @@
    the folds? One that no longer does is dropped; the rest are ordered by what they are worth.
 
 Before any of this the base model (fitted within bounds derived from the building) is given the
-lights' convective share where it settles inside the range luminaires span (``metered``), and
-checked for health (``health``): against a crippled base model any flexible extension "wins".
+interior surfaces between its air and its mass (``surfaces``) and then the lights' convective
+share (``metered``), each where it settles inside its range, and checked for health
+(``health``): against a crippled base model any flexible extension "wins".
 A base model that is inadequate, or rests a parameter on a bound the data do not press on
 (healthy, but perhaps of too low an order), is given the structural ``thermal_mass`` step, taken
 when it leaves no parameter on a bound; otherwise the candidates are still judged against the
