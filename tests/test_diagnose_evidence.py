@@ -172,6 +172,57 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
     assert not implausible.short_of_bic  # an implausible fit goes no further
 
 
+def test_a_finding_whose_input_is_too_slow_for_the_rolling_folds_is_judged_over_the_season():
+    """A ground that passed the single split is judged on held-out blocks, whose fits carry its
+    parameters through autumn and spring: accepted where the season's BIC pays for it and the
+    blocks agree, rejected where the season's BIC does not; the reason says why."""
+    folds = rolling_folds(
+        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
+    )
+    helps = _evidence([1, 1, 1], [0.6, 0.7, 0.8])
+
+    def slow(season_bic: float) -> Finding:
+        finding = _finding("ground_coupling", True, delta_bic=-40.0)
+        confirm_over_the_season(
+            finding,
+            helps,
+            folds,
+            DiagnoseSettings(),
+            "Europe/Rome",
+            season_bic,
+            ("t_ground", 0.16),
+        )
+        return finding
+
+    paid = slow(-30.0)
+    assert paid.accepted and paid.folds["training"] == "held-out blocks"
+    assert paid.detail["slow_input"] == {"signal": "t_ground", "within_fold_share": 0.16}
+    assert (
+        "judged over the season: its input t_ground varies within a fold's training weeks by "
+        "16% of its variation over the record" in paid.reason
+    )
+    assert "across held-out blocks: helps in 3 of 3 folds" in paid.reason
+    unpaid = slow(-4.0)
+    assert not unpaid.accepted and unpaid.reason.startswith(
+        "rejected: ΔBIC -4.0 over the season (median of the folds' fits); judged over the season"
+    )
+    assert unpaid.reason.endswith("(single split: test RMSE 1.000 → 0.500 K (-50%); ΔBIC -40.0)")
+
+
+def test_findings_judged_on_unlike_folds_are_compared_on_the_single_split():
+    """A ground judged on held-out blocks and a gain judged on rolling folds, both paid for by
+    the training half: the blocks' fits span the season and err less, so the two are compared on
+    the single split's test, not on their folds' errors."""
+    ground = _finding("ground_coupling", True, rmse_test_after=0.6)
+    ground.evidence = _evidence([1, 1, 1], [0.3, 0.3, 0.3])
+    ground.folds = {"training": "held-out blocks"}
+    gain = _finding("unmetered_gains", True, rmse_test_after=0.4)
+    gain.evidence = _evidence([1, 1, 1], [0.8, 0.8, 0.8])
+    gain.folds = {"helped": 3}
+    assert _winner([ground, gain], 1) is gain
+    assert ground.lost_to["reason"] == "test RMSE 0.600 K against the winner's 0.400 K"
+
+
 def test_the_season_does_not_pick_the_way_of_sun_beyond_glass():
     """Where the model already lets in more sun than glass could, which way the excess comes in
     is the excess-sun step's to judge after the selection, not the season's BIC before it."""

@@ -19,6 +19,7 @@ from rcengine.diagnose.folds import (
     held_out_blocks,
     judge_folds,
     rolling_folds,
+    within_fold_share,
 )
 from rcengine.diagnose.report import Finding, explain, verdict
 from rcengine.diagnose.selection import Selection, _backward, _one_version_each, _recheck_repair
@@ -85,6 +86,19 @@ def test_a_held_out_block_s_test_is_carried_on_from_the_rows_before_it():
     (split,) = fold_splits(frame, BUILDING, network, SignalOptions(), [block])
     assert len(split.train.segments) == 2
     _follows_without_test_measurements(network, split)
+
+
+def test_an_input_as_slow_as_the_soil_varies_little_within_a_fold_s_weeks():
+    """The soil's annual wave, read a month deep, moves within four weeks by a fifth of what it
+    moves over a heating season; the sun's daily course by all of it. A constant has no share."""
+    times = _season()
+    folds = rolling_folds(times, TZ, 28, 14, 6)
+    days = (times - times[0]) / DAY
+    soil = pd.Series(10.0 + 6.0 * np.cos(2 * np.pi * (days - 30.0) / 365.0), index=times)
+    daily = pd.Series(np.maximum(0.0, np.sin(2 * np.pi * days)), index=times)
+    assert within_fold_share(soil, folds) < 0.25
+    assert within_fold_share(daily, folds) == pytest.approx(1.0, abs=0.05)
+    assert np.isnan(within_fold_share(pd.Series(1.0, index=times), folds))
 
 
 def test_short_record_gives_fewer_or_no_folds():
@@ -247,20 +261,29 @@ def test_the_folds_choose_whether_an_unmetered_gain_has_a_base_load():
     )
 
 
-def _accepted(effect: str, round_no: int, repair: bool = False, folds: bool = True) -> Finding:
+def _accepted(
+    effect: str, round_no: int, repair: bool = False, folds: bool = True, slow: bool = False
+) -> Finding:
     """An accepted finding, on the folds' evidence unless ``folds`` is False (the opaque sun
-    judged from the glazing's magnitude after the selection)."""
+    judged from the glazing's magnitude after the selection); ``slow``: judged over the season
+    on held-out blocks, its input too slow for the rolling folds."""
     finding = Finding(effect, True, round_no, 0.0, "projection", 1.0, 1.0, baseline_repair=repair)
     finding.evidence = _evidence([0.6] * 4, [0.5] * 4) if folds and not repair else None
+    if slow:
+        finding.detail["slow_input"] = {"signal": "t_ground", "within_fold_share": 0.16}
     return finding
 
 
 def _backward_check(
-    worth: dict[str, list[float]], monkeypatch, not_on_folds: tuple[str, ...] = ()
+    worth: dict[str, list[float]],
+    monkeypatch,
+    not_on_folds: tuple[str, ...] = (),
+    slow: tuple[str, ...] = (),
 ) -> Selection:
     """The backward check on made-up fold errors: ``worth`` gives, per finding in the order they
     were accepted, the folds' test RMSE without it (with it: 0.5 K in every fold); the reduced
-    fits are tokens; the findings ``not_on_folds`` were accepted on other evidence."""
+    fits are tokens; the findings ``not_on_folds`` were accepted on other evidence, those
+    ``slow`` over the season."""
     n = len(next(iter(worth.values())))
     calls = []
 
@@ -278,7 +301,10 @@ def _backward_check(
         building=SimpleNamespace(location=SimpleNamespace(timezone=TZ)),
         say=lambda message: None,
     )
-    accepted = [_accepted(e, k + 1, folds=e not in not_on_folds) for k, e in enumerate(worth)]
+    accepted = [
+        _accepted(e, k + 1, folds=e not in not_on_folds, slow=e in slow)
+        for k, e in enumerate(worth)
+    ]
     state = Selection(current="final", accepted=[_accepted("thermal_mass", 0, True), *accepted])
     _backward(problem, state)
     state.calls = calls
@@ -464,6 +490,25 @@ def test_the_opaque_sun_judged_after_the_selection_is_checked_but_not_dropped(mo
     assert set(state.verdicts) == {"wind_infiltration"}
     opaque = state.accepted[1]
     assert opaque.backward["still_needed"] is False and opaque.accepted
+
+
+def test_a_ground_judged_over_the_season_is_not_dropped_by_the_rolling_folds(monkeypatch):
+    # The soil's temperature barely moves within a rolling fold's four weeks, so those refits
+    # cannot tell the floor's flow from the base model's heat-loss coefficient: the ground, taken
+    # over the season, fails their rule added last but is not theirs to drop. The unmetered gain
+    # taken with it, judged on the rolling folds, still is.
+    state = _backward_check(
+        {
+            "unmetered_gains": [0.52, 0.5, 0.5, 0.49],
+            "ground_coupling": [0.51, 0.5, 0.49, 0.5],
+        },
+        monkeypatch,
+        slow=("ground_coupling",),
+    )
+    assert [f.effect for f in state.accepted] == ["thermal_mass", "ground_coupling"]
+    assert set(state.verdicts) == {"unmetered_gains"}
+    ground = state.accepted[1]
+    assert ground.accepted and ground.backward["still_needed"] is False
 
 
 def test_a_fold_refit_stays_near_the_fit_on_the_training_half():

@@ -10,6 +10,7 @@ effect of physics helps in most of them, a seasonal coincidence in few.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -208,6 +209,28 @@ class FoldRule:
 
     min_share: float = 0.5
     min_improvement: float = 0.10
+
+
+# An input that varies within a fold's training weeks by less than this share of its variation
+# over the record changes too slowly for a four-week refit to tell its effect from the base
+# model's own parameters: the ground's seasonal soil temperature varies there by 16–19 % of its
+# variation over a heating season (measured on the dev pool, docs/diagnosis/history.md), the
+# sun, the sky, the wind and learnt schedules by most of theirs. Such an effect is judged over
+# the season, on the held-out blocks (``held_out_blocks``), whose fits carry its parameters
+# through autumn and spring as the physics must. [-]
+SLOW_INPUT_SHARE = 0.5
+
+
+def within_fold_share(record: pd.Series, folds: Sequence[Fold]) -> float:
+    """The median over the folds' training weeks of an input's standard deviation, as a share of
+    its standard deviation over ``record`` (the input on the record's times); nan for an input
+    constant over the record."""
+    values = record.to_numpy(dtype=float)
+    whole = float(np.nanstd(values))
+    if not whole > 1e-9:
+        return float("nan")
+    windows = [values[f.in_training(record.index)] for f in folds]
+    return float(np.median([np.nanstd(w) for w in windows if w.size])) / whole
 
 
 def judge_folds(evidence: FoldEvidence, rule: FoldRule) -> tuple[bool, str]:

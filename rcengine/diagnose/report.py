@@ -226,15 +226,31 @@ def confirm_over_the_season(
     settings: DiagnoseSettings,
     timezone: str,
     season_bic: float,
+    slow: tuple[str, float] | None = None,
 ) -> None:
-    """A finding short of the training half's BIC alone (``short_of_bic``), judged on held-out
-    blocks: it passes the BIC where ``season_bic``, its ΔBIC on the blocks' fits over the season
-    around each test window, is within the margin, and is then judged as ``confirm_on_folds``."""
+    """A finding judged on held-out blocks: one short of the training half's BIC alone
+    (``short_of_bic``), or one that passed the single split but whose input is too slow for the
+    rolling folds (``slow``: the input and its ``folds.within_fold_share``). It passes the BIC
+    where ``season_bic``, its ΔBIC on the blocks' fits over the season around each test window,
+    is within the margin, and is then judged as ``confirm_on_folds``."""
     finding.detail["season_delta_bic"] = season_bic
     season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
+    if slow is not None:
+        signal, share = slow
+        finding.detail["slow_input"] = {"signal": signal, "within_fold_share": share}
+        season += (
+            f"; judged over the season: its input {signal} varies within a fold's training "
+            f"weeks by {share:.0%} of its variation over the record, too slowly for a refit on "
+            "them to tell it from the base model"
+        )
     if season_bic > -settings.bic_margin:
         _record(finding, evidence, blocks, timezone, HELD_OUT_BLOCKS)
-        finding.reason += f", {season}"
+        if finding.accepted:
+            single = finding.reason.removeprefix("accepted: ")
+            finding.reason = f"rejected: ΔBIC {season} (single split: {single})"
+        else:
+            finding.reason += f", {season}"
+        finding.accepted = False
         return
     finding.reason = (
         f"accepted: {_test_change(finding.rmse_test_before, finding.rmse_test_after)}; "

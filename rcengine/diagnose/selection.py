@@ -66,12 +66,14 @@ from rcengine.diagnose.fitting import (
     trust_region,
 )
 from rcengine.diagnose.folds import (
+    SLOW_INPUT_SHARE,
     Fold,
     FoldEvidence,
     head_to_head,
     held_out_blocks,
     judge_folds,
     rolling_folds,
+    within_fold_share,
 )
 from rcengine.diagnose.health import (
     FitQuality,
@@ -950,12 +952,18 @@ def _confirm_on_folds(
 ) -> None:
     """Refit the current model and every extension that passed the single split on each fold
     (warm-started from their fits on the whole training period, in one parallel batch) and keep
-    only those that help across the folds (``confirm_on_folds``)."""
+    only those that help across the folds (``confirm_on_folds``). Under "hybrid" fold training,
+    those short of the training half's BIC alone and those whose input is too slow for the
+    rolling folds (``_slow_input``) are judged over the season instead."""
     pairs = list(zip(extensions, findings, strict=True))
+    slow = {}
     if problem.settings.fold_training == "hybrid":
-        _confirm_over_the_season(problem, state, [(e, f) for e, f in pairs if f.short_of_bic])
+        slow = {id(f): _slow_input(problem, e, f) for e, f in pairs if f.accepted}
+        slow = {k: v for k, v in slow.items() if v is not None}
+        season = [(e, f) for e, f in pairs if f.short_of_bic or id(f) in slow]
+        _confirm_over_the_season(problem, state, season, slow)
     # Those judged over the season keep that evidence: the rolling folds are not asked again.
-    passing = [(e, f) for e, f in pairs if f.accepted and not f.short_of_bic]
+    passing = [(e, f) for e, f in pairs if f.accepted and not f.short_of_bic and id(f) not in slow]
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
@@ -976,11 +984,32 @@ def _confirm_on_folds(
         )
 
 
+def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> tuple[str, float] | None:
+    """The extension's input that varies most within the rolling folds' training weeks, with
+    that share of its variation over the record (``folds.within_fold_share``), when even it
+    varies less than ``SLOW_INPUT_SHARE``; None for a structural extension or a fast input."""
+    split = finding.fit.split
+    shares = {}
+    for signal, _ in ext.inputs:
+        record = pd.concat([split.train.frame[signal], split.test.frame[signal]])
+        share = within_fold_share(record, problem.folds)
+        if np.isfinite(share):
+            shares[signal] = share
+    if not shares or max(shares.values()) >= SLOW_INPUT_SHARE:
+        return None
+    fastest = max(shares, key=shares.__getitem__)
+    return fastest, shares[fastest]
+
+
 def _confirm_over_the_season(
-    problem: Problem, state: Selection, short: list[tuple[Extension, Finding]]
+    problem: Problem,
+    state: Selection,
+    season: list[tuple[Extension, Finding]],
+    slow: dict[int, tuple[str, float]],
 ) -> None:
-    """Findings short of the training half's BIC alone, judged on held-out blocks."""
-    short = _not_the_excess_sun(short, sun_as_glazing_g(state.current))
+    """Findings judged on held-out blocks: short of the training half's BIC alone, or passing
+    the single split with an input too slow for the rolling folds (``slow``, by finding)."""
+    short = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
     if not short:
         return
     blocks = held_out_blocks(problem.folds, problem.frame.index)
@@ -1000,25 +1029,31 @@ def _confirm_over_the_season(
             problem.settings,
             problem.building.location.timezone,
             _season_bic(state.current_blocks, fold_fits),
+            slow.get(id(finding)),
         )
 
 
 def _not_the_excess_sun(
     short: list[tuple[Extension, Finding]], g: float | None
 ) -> list[tuple[Extension, Finding]]:
-    """``short`` but the ways the sun comes in, where the model already lets in more than glass
-    could (``g``, its sun as the declared glazing's g-value): which way carries that excess is
-    the excess-sun step's to judge, with the sun held to glass, after the selection; the season's
-    evidence is no ground to pick one before it. Those left out are rejected with why."""
+    """``short`` but the ways the sun comes in that fell short of the BIC, where the model
+    already lets in more than glass could (``g``, its sun as the declared glazing's g-value):
+    which way carries that excess is the excess-sun step's to judge, with the sun held to glass,
+    after the selection; the season's evidence is no ground to pick one before it. Those left
+    out are rejected with why."""
     if g is None or g <= G_GLAZING_MAX:
         return short
-    for _, finding in (p for p in short if p[1].effect in EXCESS_EFFECTS):
+    kept = []
+    for ext, finding in short:
+        if not (finding.short_of_bic and finding.effect in EXCESS_EFFECTS):
+            kept.append((ext, finding))
+            continue
         finding.short_of_bic = False
         finding.reason += (
             f"; the model's sun is already beyond glass (as g = {g:.2f}): the excess-sun step "
             "judges which way it comes in"
         )
-    return [p for p in short if p[1].short_of_bic]
+    return kept
 
 
 def _season_bic(current: list[Fit], extended: list[Fit]) -> float:
@@ -1087,10 +1122,11 @@ def _backward(problem: Problem, state: Selection) -> None:
     entered by) and is worth least is dropped and the check repeated on the model without it;
     the findings kept are ordered by what leaving each out costs on the folds' pooled test, the
     one that matters most first. Steps taken to make the base model healthy are not candidates
-    and stay first. A finding accepted on other evidence than the folds (the opaque sun, from
-    what the declared glazing admits beyond glass, ``excess_sun``) is ordered with the others
-    but not dropped by them; it is checked after it too, since a finding taken before it may
-    have stood in for its sun.
+    and stay first. A finding accepted on other evidence than the rolling folds (the opaque sun,
+    from what the declared glazing admits beyond glass, ``excess_sun``; an input too slow for
+    them, judged over the season, ``_slow_input``) is ordered with the others but not dropped by
+    them; the opaque sun is checked after it too, since a finding taken before it may have stood
+    in for its sun.
     """
     rule = problem.settings.fold_rule
     while problem.folds:
@@ -1105,7 +1141,7 @@ def _backward(problem: Problem, state: Selection) -> None:
             ok, text = judge_folds(ev, rule)
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
             finding.backward = _added_last(problem, ev, text, still_needed=ok)
-            if not ok and finding.evidence is not None:
+            if not ok and finding.evidence is not None and "slow_input" not in finding.detail:
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
         if not failing:
@@ -1244,8 +1280,15 @@ def _duel(first: Finding, second: Finding) -> tuple[int, str]:
         # Judged on unlike folds (held-out blocks fit more data): the one the training half
         # pays for comes first, the season's on its own evidence in a later round.
         return int(first.short_of_bic), "the training half pays for the winner, not for it"
-    if first.evidence is not None and second.evidence is not None:
+    if first.evidence is not None and second.evidence is not None and _alike(first, second):
         return head_to_head(first.evidence, second.evidence)
     winner = 0 if first.improvement_k >= second.improvement_k else 1
     lo, hi = sorted((first.rmse_test_after, second.rmse_test_after))
     return winner, f"test RMSE {hi:.3f} K against the winner's {lo:.3f} K"
+
+
+def _alike(first: Finding, second: Finding) -> bool:
+    """Whether two findings were judged on folds fitted alike (both on the rolling folds, or both
+    on the held-out blocks, ``Finding.folds["training"]``): the blocks' fits span the season and
+    err less, so their test errors are no match for the rolling folds'."""
+    return (first.folds or {}).get("training") == (second.folds or {}).get("training")
