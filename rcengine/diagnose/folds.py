@@ -213,7 +213,7 @@ class FoldRule:
 
 # An input that varies within a fold's training weeks by less than this share of its variation
 # over the record changes too slowly for a four-week refit to tell its effect from the base
-# model's own parameters: the ground's seasonal soil temperature varies there by 16–19 % of its
+# model's own parameters: the ground's seasonal soil temperature varies there by 14–19 % of its
 # variation over a heating season (measured on the dev pool, docs/diagnosis/history.md), the
 # sun, the sky, the wind and learnt schedules by most of theirs. Such an effect is judged over
 # the season, on the held-out blocks (``held_out_blocks``), whose fits carry its parameters
