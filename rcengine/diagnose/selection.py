@@ -1009,8 +1009,8 @@ def _confirm_over_the_season(
 ) -> None:
     """Findings judged on held-out blocks: short of the training half's BIC alone, or passing
     the single split with an input too slow for the rolling folds (``slow``, by finding)."""
-    short = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
-    if not short:
+    judged = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
+    if not judged:
         return
     blocks = held_out_blocks(problem.folds, problem.frame.index)
     seasonal = replace(problem, folds=blocks)
@@ -1019,9 +1019,9 @@ def _confirm_over_the_season(
         (state.current_blocks,) = _fold_fits(
             seasonal, [(current.network, current.options, current.params)]
         )
-    fits = _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in short])
+    fits = _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in judged])
     before = tuple(f.residual_test for f in state.current_blocks)
-    for (_, finding), fold_fits in zip(short, fits, strict=True):
+    for (_, finding), fold_fits in zip(judged, fits, strict=True):
         confirm_over_the_season(
             finding,
             FoldEvidence(before, tuple(f.residual_test for f in fold_fits)),
