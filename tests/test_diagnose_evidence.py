@@ -183,14 +183,9 @@ def test_a_finding_whose_input_is_too_slow_for_the_rolling_folds_is_judged_over_
 
     def slow(season_bic: float) -> Finding:
         finding = _finding("ground_coupling", True, delta_bic=-40.0)
+        finding.detail["slow_input"] = {"signal": "t_ground", "within_fold_share": 0.16}
         confirm_over_the_season(
-            finding,
-            helps,
-            folds,
-            DiagnoseSettings(),
-            "Europe/Rome",
-            season_bic,
-            ("t_ground", 0.16),
+            finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic
         )
         return finding
 

@@ -119,6 +119,9 @@ class Finding:
 # How a finding judged over the season was refitted, in its report's ``folds`` (``training``):
 # each fold on the whole record but its test window and guard days (``folds.held_out_blocks``).
 HELD_OUT_BLOCKS = "held-out blocks"
+# A finding's ``detail`` key for the input too slow for the rolling folds that sent it to the
+# held-out blocks (``selection._slow_input``): {"signal", "within_fold_share"}.
+SLOW_INPUT = "slow_input"
 
 
 def _test_change(before: float, after: float) -> str:
@@ -226,22 +229,20 @@ def confirm_over_the_season(
     settings: DiagnoseSettings,
     timezone: str,
     season_bic: float,
-    slow: tuple[str, float] | None = None,
 ) -> None:
     """A finding judged on held-out blocks: one short of the training half's BIC alone
     (``short_of_bic``), or one that passed the single split but whose input is too slow for the
-    rolling folds (``slow``: the input and its ``folds.within_fold_share``). It passes the BIC
-    where ``season_bic``, its ΔBIC on the blocks' fits over the season around each test window,
-    is within the margin, and is then judged as ``confirm_on_folds``."""
+    rolling folds (``detail[SLOW_INPUT]``: the input and its ``folds.within_fold_share``). It
+    passes the BIC where ``season_bic``, its ΔBIC on the blocks' fits over the season around each
+    test window, is within the margin, and is then judged as ``confirm_on_folds``."""
     finding.detail["season_delta_bic"] = season_bic
     season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
+    slow = finding.detail.get(SLOW_INPUT)
     if slow is not None:
-        signal, share = slow
-        finding.detail["slow_input"] = {"signal": signal, "within_fold_share": share}
         season += (
-            f"; judged over the season: its input {signal} varies within a fold's training "
-            f"weeks by {share:.0%} of its variation over the record, too slowly for a refit on "
-            "them to tell it from the base model"
+            f"; judged over the season: its input {slow['signal']} varies within a fold's "
+            f"training weeks by {slow['within_fold_share']:.0%} of its variation over the "
+            "record, too slowly for a refit on them to tell it from the base model"
         )
     if season_bic > -settings.bic_margin:
         _record(finding, evidence, blocks, timezone, HELD_OUT_BLOCKS)

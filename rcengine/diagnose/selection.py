@@ -92,6 +92,7 @@ from rcengine.diagnose.metered import (
 )
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
+    SLOW_INPUT,
     Finding,
     Report,
     confirm_on_folds,
@@ -956,14 +957,17 @@ def _confirm_on_folds(
     those short of the training half's BIC alone and those whose input is too slow for the
     rolling folds (``_slow_input``) are judged over the season instead."""
     pairs = list(zip(extensions, findings, strict=True))
-    slow = {}
     if problem.settings.fold_training == "hybrid":
-        slow = {id(f): _slow_input(problem, e, f) for e, f in pairs if f.accepted}
-        slow = {k: v for k, v in slow.items() if v is not None}
-        season = [(e, f) for e, f in pairs if f.short_of_bic or id(f) in slow]
-        _confirm_over_the_season(problem, state, season, slow)
+        for e, f in pairs:
+            slow = _slow_input(problem, e, f) if f.accepted else None
+            if slow is not None:
+                f.detail[SLOW_INPUT] = slow
+        season = [(e, f) for e, f in pairs if f.short_of_bic or SLOW_INPUT in f.detail]
+        _confirm_over_the_season(problem, state, season)
     # Those judged over the season keep that evidence: the rolling folds are not asked again.
-    passing = [(e, f) for e, f in pairs if f.accepted and not f.short_of_bic and id(f) not in slow]
+    passing = [
+        (e, f) for e, f in pairs if f.accepted and not f.short_of_bic and SLOW_INPUT not in f.detail
+    ]
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
@@ -984,10 +988,11 @@ def _confirm_on_folds(
         )
 
 
-def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> tuple[str, float] | None:
+def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> dict | None:
     """The extension's input that varies most within the rolling folds' training weeks, with
-    that share of its variation over the record (``folds.within_fold_share``), when even it
-    varies less than ``SLOW_INPUT_SHARE``; None for a structural extension or a fast input."""
+    that share of its variation over the record (``folds.within_fold_share``), as the finding's
+    ``detail[SLOW_INPUT]``, when even it varies less than ``SLOW_INPUT_SHARE``; None for a
+    structural extension or a fast input."""
     split = finding.fit.split
     shares = {}
     for signal, _ in ext.inputs:
@@ -998,17 +1003,16 @@ def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> tuple[str
     if not shares or max(shares.values()) >= SLOW_INPUT_SHARE:
         return None
     fastest = max(shares, key=shares.__getitem__)
-    return fastest, shares[fastest]
+    return {"signal": fastest, "within_fold_share": shares[fastest]}
 
 
 def _confirm_over_the_season(
     problem: Problem,
     state: Selection,
     season: list[tuple[Extension, Finding]],
-    slow: dict[int, tuple[str, float]],
 ) -> None:
     """Findings judged on held-out blocks: short of the training half's BIC alone, or passing
-    the single split with an input too slow for the rolling folds (``slow``, by finding)."""
+    the single split with an input too slow for the rolling folds (``detail[SLOW_INPUT]``)."""
     judged = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
     if not judged:
         return
@@ -1029,7 +1033,6 @@ def _confirm_over_the_season(
             problem.settings,
             problem.building.location.timezone,
             _season_bic(state.current_blocks, fold_fits),
-            slow.get(id(finding)),
         )
 
 
@@ -1141,7 +1144,7 @@ def _backward(problem: Problem, state: Selection) -> None:
             ok, text = judge_folds(ev, rule)
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
             finding.backward = _added_last(problem, ev, text, still_needed=ok)
-            if not ok and finding.evidence is not None and "slow_input" not in finding.detail:
+            if not ok and finding.evidence is not None and SLOW_INPUT not in finding.detail:
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
         if not failing:
