@@ -180,7 +180,7 @@ CASES = {
         "3.5 W/(m²K) exceeds any floor (≤ 3.03 W/(m²K))",
     ),
     "sky_radiation": Case(
-        lambda e: {"u_sky": 0.5},
+        lambda e: {"u_sky": 1.0},
         lambda e: {"u_sky": 15.0},
         "U-value of the sky-viewing envelope, roof + ½ wall (155 m²), at ε·h_r = 4.2 W/(m²K): "
         "15 W/(m²K) exceeds any envelope surface",
@@ -462,12 +462,26 @@ def test_sky_loss_reads_as_the_u_value_of_the_sky_viewing_envelope(gain_context)
     whatever share of the wall node's heat goes outdoors."""
     ext = CANDIDATES["sky_radiation"](gain_context)
     assert 0.0 < ext.detail["node_share"] < 1.0
-    params = {**TRUTH_BASIC, "u_sky": 0.5}
+    params = {**TRUTH_BASIC, "u_sky": 0.9}
     gains = steady_state_gains(ext.network, params)
     area = ext.detail["sky_view_area_m2"]
-    assert gains[SKY_DELTA] / gains[Q_HVAC] == pytest.approx(0.5 * 0.08 * SKY_H_R_TYPICAL * area)
+    assert gains[SKY_DELTA] / gains[Q_HVAC] == pytest.approx(0.9 * 0.08 * SKY_H_R_TYPICAL * area)
     reading = assess(ext, params)
-    assert reading.plausible and reading.magnitudes["u_sky"]["value"] == pytest.approx(0.5)
+    assert reading.plausible and reading.magnitudes["u_sky"]["value"] == pytest.approx(0.9)
+
+
+def test_an_insulated_envelope_s_sky_loss_is_no_finding(gain_context):
+    """Every envelope loses heat to the sky: a fit that reads an insulated roof's U (0.23, as on
+    the open-plan Torino null) names no physics the building lacks; a concrete roof under 25 mm
+    of insulation (0.9, the sky variant's) does."""
+    ext = CANDIDATES["sky_radiation"](gain_context)
+    insulated = assess(ext, {**TRUTH_BASIC, "u_sky": 0.23})
+    assert insulated.problems == [
+        "U-value of the sky-viewing envelope, roof + ½ wall (155 m²), at ε·h_r = 4.2 W/(m²K): "
+        "0.23 W/(m²K) is below any poorly insulated envelope, the sky loss an insulated one has "
+        "being every building's (≥ 0.5 W/(m²K))"
+    ]
+    assert assess(ext, {**TRUTH_BASIC, "u_sky": 0.9}).plausible
 
 
 def test_physical_units_reach_the_network_scaled_by_the_building(gain_context):
