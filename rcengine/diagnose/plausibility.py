@@ -404,7 +404,8 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 
 def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """The sky-viewing envelope's U-value at ε·h_r = ``SKY_H_R_TYPICAL`` (the steady share
-    reached, read from the fitted network), at most the poorest wall's at the highest coupling.
+    reached, read from the fitted network), at most the poorest wall's at the highest coupling
+    and, to be a finding, at least a poorly insulated roof's (``SKY_U_INSULATED``).
 
     Unlike the opaque sun's, it is not held against the fitted UA: the sky temperature it is
     driven by (an estimated dew point and cloud cover) is itself uncertain by tens of percent,
