@@ -962,12 +962,9 @@ def _confirm_on_folds(
             slow = _slow_input(problem, e, f) if f.accepted else None
             if slow is not None:
                 f.detail[SLOW_INPUT] = slow
-        season = [(e, f) for e, f in pairs if f.short_of_bic or SLOW_INPUT in f.detail]
-        _confirm_over_the_season(problem, state, season)
+        _confirm_over_the_season(problem, state, [p for p in pairs if _over_the_season(p[1])])
     # Those judged over the season keep that evidence: the rolling folds are not asked again.
-    passing = [
-        (e, f) for e, f in pairs if f.accepted and not f.short_of_bic and SLOW_INPUT not in f.detail
-    ]
+    passing = [(e, f) for e, f in pairs if f.accepted and not _over_the_season(f)]
     if not passing:
         return
     models = [(e.network, e.signals, f.fit.params) for e, f in passing]
@@ -986,6 +983,12 @@ def _confirm_on_folds(
             problem.settings,
             problem.building.location.timezone,
         )
+
+
+def _over_the_season(finding: Finding) -> bool:
+    """Whether ``finding`` is judged on the held-out blocks rather than the rolling folds: short
+    of the training half's BIC alone, or with an input too slow for the rolling folds."""
+    return finding.short_of_bic or SLOW_INPUT in finding.detail
 
 
 def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> dict | None:
