@@ -33,7 +33,9 @@ from rcengine.diagnose.candidates import (
 )
 from rcengine.diagnose.declared import with_declared_glazing
 from rcengine.diagnose.plausibility import GROUND_TEMPERATURE_MARGIN_K, SKY_H_R_TYPICAL, assess
+from rcengine.diagnose.report import improvement_check
 from rcengine.diagnose.response import node_responses
+from rcengine.diagnose.settings import DiagnoseSettings
 from rcengine.io.epw import read_epw
 from rcengine.models import get_model
 from rcengine.models.physical import steady_share, steady_state_gains
@@ -482,6 +484,28 @@ def test_an_insulated_envelope_s_sky_loss_is_no_finding(gain_context):
         "being every building's (≥ 0.5 W/(m²K))"
     ]
     assert assess(ext, {**TRUTH_BASIC, "u_sky": 0.9}).plausible
+
+
+def test_a_sky_loss_only_a_poorly_insulated_envelope_has_is_evident(gain_context):
+    """From 1.0 W/(m²K), above a concrete roof under 25 mm of insulation, the sky loss is
+    evident; below it, or where another reading is impossible, it is not."""
+    ext = CANDIDATES["sky_radiation"](gain_context)
+    assert assess(ext, {**TRUTH_BASIC, "u_sky": 1.2}).evident
+    assert not assess(ext, {**TRUTH_BASIC, "u_sky": 0.9}).evident
+    assert not assess(ext, {**TRUTH_BASIC, "u_sky": 15.0}).evident
+    wind = CANDIDATES["wind_infiltration"](gain_context)
+    assert not assess(wind, {**TRUTH_BASIC, "ach_wind": 0.3}).evident
+
+
+def test_an_evident_magnitude_asks_a_relative_cut_without_the_kelvin_margin():
+    """A 7 % cut of 0.5 K (0.035 K, under a sensor's 0.1 K) is no evidence for an ordinary fit
+    and enough for an evident one; a 3 % cut is enough for neither."""
+    settings = DiagnoseSettings()
+    assert improvement_check(0.5, 0.465, settings) == (False, "test RMSE 0.500 → 0.465 K (-7%)")
+    ok, text = improvement_check(0.5, 0.465, settings, evident=True)
+    assert ok and text.endswith("its magnitude evident (a 5% cut asked)")
+    assert not improvement_check(0.5, 0.485, settings, evident=True)[0]
+    assert improvement_check(2.0, 1.7, settings)[0]
 
 
 def test_physical_units_reach_the_network_scaled_by_the_building(gain_context):

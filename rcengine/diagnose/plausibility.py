@@ -106,6 +106,12 @@ SKY_H_R_TYPICAL = H_RE
 # walls' half) and 0.5 or more on 9 of 147; on two of them, the open-plan Torino null of sets 7
 # and 15, it was accepted at 0.23. [W/(m²K)]
 SKY_U_INSULATED = 0.5
+# A sky loss twice that floor, 1.0 W/(m²K), is above a concrete roof under 25 mm of insulation
+# (0.9): the envelope is evidently a poorly insulated one. No dev-pool null read it (0.85 the
+# most, 0.06 the median), so a fit that does needs no kelvin margin to be told from noise, only
+# the relative cut an evident magnitude asks (``DiagnoseSettings.min_improvement_evident``): a
+# clear night's loss is a small share of a test error that other hours fill. [W/(m²K)]
+SKY_U_POOR = 2.0 * SKY_U_INSULATED
 # Storage the model lacks, per m² of floor: the base models' internal-mass range (10–1000 kJ).
 EXTRA_CAPACITY_J_M2K: Range = KAPPA_INTERNAL
 # The heaviest emitter: a thermally activated building system (ISO 11855-4, EN 15377-3), pipes
@@ -132,7 +138,8 @@ EMITTER_CAPACITY_J_M2K: Range = (0.0, TABS_CAPACITY_J_M2K)
 class Reading:
     """One fitted magnitude in physical units; ``plausible`` None when it is reported only, and
     ``of`` names what the range covers, for the reason ("exceeds any glazing"); ``below``, where
-    it differs, what its lower bound does."""
+    it differs, what its lower bound does; ``evident``, where set, the value from which the
+    magnitude alone tells the effect apart from every building's (``Assessment.evident``)."""
 
     key: str
     value: float
@@ -141,6 +148,7 @@ class Reading:
     plausible: Range | None = None
     of: str = ""
     below: str = ""
+    evident: float | None = None
 
     def problem(self) -> str | None:
         """The plain-words reason this magnitude is impossible, or None."""
@@ -161,11 +169,13 @@ class Reading:
 
 @dataclass(frozen=True)
 class Assessment:
-    """The fitted extension's magnitudes ``{key: {value, unit, meaning}}`` and the reasons, in
-    plain words, that any of them is impossible for the building."""
+    """The fitted extension's magnitudes ``{key: {value, unit, meaning}}``, the reasons, in
+    plain words, that any of them is impossible for the building, and whether a plausible one is
+    evident: at or above its ``Reading.evident``."""
 
     magnitudes: dict[str, dict]
     problems: list[str]
+    evident: bool = False
 
     @property
     def plausible(self) -> bool:
@@ -177,7 +187,8 @@ def assess(ext: Extension, params: Mapping[str, float]) -> Assessment:
     physical units and check each against its plausible range."""
     readings = READERS[ext.effect](ext, params)
     problems = [p for r in readings if (p := r.problem()) is not None]
-    return Assessment({r.key: r.as_dict() for r in readings}, problems)
+    evident = any(r.evident is not None and r.value >= r.evident for r in readings)
+    return Assessment({r.key: r.as_dict() for r in readings}, problems, evident and not problems)
 
 
 def _readable_steady(ext: Extension, params: Mapping[str, float]) -> bool:
@@ -405,7 +416,8 @@ def _ground(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
 def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
     """The sky-viewing envelope's U-value at ε·h_r = ``SKY_H_R_TYPICAL`` (the steady share
     reached, read from the fitted network), at most the poorest wall's at the highest coupling
-    and, to be a finding, at least a poorly insulated roof's (``SKY_U_INSULATED``).
+    and, to be a finding, at least a poorly insulated roof's (``SKY_U_INSULATED``); evident from
+    ``SKY_U_POOR``.
 
     Unlike the opaque sun's, it is not held against the fitted UA: the sky temperature it is
     driven by (an estimated dew point and cloud cover) is itself uncertain by tens of percent,
@@ -427,6 +439,7 @@ def _sky(ext: Extension, params: Mapping[str, float]) -> list[Reading]:
             (SKY_U_INSULATED, U_OPAQUE[1] * SKY_COUPLING[1] / SKY_H_R_TYPICAL),
             "envelope surface",
             "poorly insulated envelope, the sky loss an insulated one has being every building's",
+            SKY_U_POOR,
         )
     ]
 

@@ -128,6 +128,22 @@ def _test_change(before: float, after: float) -> str:
     return f"test RMSE {before:.3f} → {after:.3f} K ({(after - before) / before:+.0%})"
 
 
+def improvement_check(
+    before: float, after: float, settings: DiagnoseSettings, evident: bool = False
+) -> tuple[bool, str]:
+    """Whether the test RMSE [K] fell from ``before`` to ``after`` by the relative cut and the
+    kelvin margin of ``settings``, or, for a fit whose magnitude is ``evident``, by the smaller
+    relative cut alone; with the change in words."""
+    gain, text = before - after, _test_change(before, after)
+    if evident:
+        cut = settings.min_improvement_evident
+        return gain >= cut * before, f"{text}, its magnitude evident (a {cut:.0%} cut asked)"
+    return (
+        gain >= settings.min_improvement * before and gain >= settings.min_improvement_k,
+        text,
+    )
+
+
 def judge(
     ext: Extension,
     current: Fit,
@@ -136,20 +152,19 @@ def judge(
     round_no: int,
     settings: DiagnoseSettings,
     building: Building,
+    evident: bool = False,
 ) -> Finding:
-    """Accept an extension only for a meaningful test improvement that the BIC confirms."""
+    """Accept an extension only for a meaningful test improvement that the BIC confirms: a
+    relative cut of the test RMSE and one in kelvin, or, for a fit whose magnitude is ``evident``
+    (``plausibility.Assessment``), the smaller relative cut such a fit asks alone."""
     before, after = current.rmse_test, fit.rmse_test
     change = fit.criteria_change(current)
     delta_bic = change["bic"]
     new = {p: fit.params[p] for p in ext.new_parameters}
     bounds = [p for p in fit.at_bounds if p in ext.new_parameters]
     idle = is_idle(ext, fit.params)
-    gain = before - after
     checks = [
-        (
-            gain >= settings.min_improvement * before and gain >= settings.min_improvement_k,
-            _test_change(before, after),
-        ),
+        improvement_check(before, after, settings, evident),
         (delta_bic <= -settings.bic_margin, f"ΔBIC {delta_bic:+.1f}"),
         (not idle, "fitted gain is zero" if idle else "fitted gain is non-zero"),
     ]

@@ -481,9 +481,18 @@ def _judge(
     problem: Problem, ext: Extension, current: Fit, fit: Fit, screened: Screen, round_no: int
 ) -> Finding:
     """The single split's verdict on a refitted extension, with its fitted magnitudes in
-    physical units; an implausible magnitude rejects it."""
-    finding = judge(ext, current, fit, screened, round_no, problem.settings, problem.building)
+    physical units; an implausible magnitude rejects it, an evident one asks a smaller cut."""
     assessment = assess(ext, fit.params)
+    finding = judge(
+        ext,
+        current,
+        fit,
+        screened,
+        round_no,
+        problem.settings,
+        problem.building,
+        assessment.evident,
+    )
     reject_implausible(finding, assessment.magnitudes, assessment.problems)
     return finding
 

@@ -38,10 +38,12 @@ class DiagnoseSettings:
     most promising by their earlier refit and screen (default: all of them; fewer trades a pair's
     second effect for speed); min_improvement: relative test-RMSE cut an extension must bring, and
     min_improvement_k in kelvin (0.1 K, a room sensor's accuracy: smaller gains are no evidence of
-    physics); bic_margin: how much the effective-n BIC must drop; max_rounds: forward-selection
-    rounds; baseline_starts: independent searches for the baseline fit (best kept); workers:
-    processes for the refits of a round (default: every core); effects: the candidate ids to
-    consider (default: the whole vocabulary); bounds: the base model's parameter bounds, "building"
+    physics), or min_improvement_evident alone for a fit whose magnitude tells the effect apart
+    from every building's (``plausibility.Assessment.evident``); bic_margin: how much the
+    effective-n BIC must drop; max_rounds: forward-selection rounds; baseline_starts: independent
+    searches for the baseline fit (best kept); workers: processes for the refits of a round
+    (default: every core); effects: the candidate ids to consider (default: the whole
+    vocabulary); bounds: the base model's parameter bounds, "building"
     (derived from its description) or "thesis" (Table 2.3); evidence: "folds" confirms an extension
     that passes the single split on rolling folds across the record (fold_train_days of training,
     the next fold_test_days tested, up to max_folds origins, each refitted with fold_preset from the
@@ -68,6 +70,7 @@ class DiagnoseSettings:
     confirm: int = len(CANDIDATES)
     min_improvement: float = 0.10
     min_improvement_k: float = 0.1
+    min_improvement_evident: float = 0.05
     bic_margin: float = 10.0
     max_rounds: int = 3
     baseline_starts: int = 4
