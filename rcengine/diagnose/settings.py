@@ -43,8 +43,8 @@ class DiagnoseSettings:
     effective-n BIC must drop; max_rounds: forward-selection rounds; baseline_starts: independent
     searches for the baseline fit (best kept); workers: processes for the refits of a round
     (default: every core); effects: the candidate ids to consider (default: the whole
-    vocabulary); bounds: the base model's parameter bounds, "building"
-    (derived from its description) or "thesis" (Table 2.3); evidence: "folds" confirms an extension
+    vocabulary); bounds: the base model's parameter bounds, "building" (derived from its
+    description) or "thesis" (Table 2.3); evidence: "folds" confirms an extension
     that passes the single split on rolling folds across the record (fold_train_days of training,
     the next fold_test_days tested, up to max_folds origins, each refitted with fold_preset from the
     fit on the training half; accepted when it helps in more than min_fold_share of them and cuts
