@@ -172,24 +172,24 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
     assert not implausible.short_of_bic  # an implausible fit goes no further
 
 
+def _slow_ground(season_bic: float, accepted: bool = True, **fields) -> Finding:
+    """A made-up ground (ΔBIC −40 on the training half; ``fields`` its single split's verdict)
+    whose soil is too slow for the rolling folds, judged on three held-out blocks it helps."""
+    folds = rolling_folds(
+        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
+    )
+    finding = _finding("ground_coupling", accepted, **{"delta_bic": -40.0, **fields})
+    finding.detail["slow_input"] = {"signal": "t_ground", "within_fold_share": 0.16}
+    helps = _evidence([1, 1, 1], [0.6, 0.7, 0.8])
+    confirm_over_the_season(finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic)
+    return finding
+
+
 def test_a_finding_whose_input_is_too_slow_for_the_rolling_folds_is_judged_over_the_season():
     """A ground that passed the single split is judged on held-out blocks, whose fits carry its
     parameters through autumn and spring: accepted where the season's BIC pays for it and the
     blocks agree, rejected where the season's BIC does not; the reason says why."""
-    folds = rolling_folds(
-        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
-    )
-    helps = _evidence([1, 1, 1], [0.6, 0.7, 0.8])
-
-    def slow(season_bic: float) -> Finding:
-        finding = _finding("ground_coupling", True, delta_bic=-40.0)
-        finding.detail["slow_input"] = {"signal": "t_ground", "within_fold_share": 0.16}
-        confirm_over_the_season(
-            finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic
-        )
-        return finding
-
-    paid = slow(-30.0)
+    paid = _slow_ground(-30.0)
     assert paid.accepted and paid.folds["training"] == "held-out blocks"
     assert paid.detail["slow_input"] == {"signal": "t_ground", "within_fold_share": 0.16}
     assert (
@@ -197,11 +197,44 @@ def test_a_finding_whose_input_is_too_slow_for_the_rolling_folds_is_judged_over_
         "16% of its variation over the record" in paid.reason
     )
     assert "across held-out blocks: helps in 3 of 3 folds" in paid.reason
-    unpaid = slow(-4.0)
+    unpaid = _slow_ground(-4.0)
     assert not unpaid.accepted and unpaid.reason.startswith(
         "rejected: ΔBIC -4.0 over the season (median of the folds' fits); judged over the season"
     )
     assert unpaid.reason.endswith("(single split: test RMSE 1.000 → 0.500 K (-50%); ΔBIC -40.0)")
+
+
+def test_a_slow_input_short_of_the_single_split_s_test_alone_is_judged_over_the_season():
+    """The single split tests a ground fitted on autumn against the spring: its soil's slow
+    course is confounded there with every seasonal trend (the sun's rise), so a ground short of
+    that test alone — its BIC paid, its magnitudes plausible — is judged on held-out blocks, whose
+    fits span the season; the reason keeps the single split's figure and says why it is not
+    asked."""
+
+    def short(season_bic: float) -> Finding:
+        return _slow_ground(
+            season_bic,
+            False,
+            rmse_test_after=1.1,
+            reason="rejected: test RMSE 1.000 → 1.100 K (+10%)",
+            short_of_test=True,
+        )
+
+    paid = short(-30.0)
+    assert paid.accepted and paid.folds["training"] == "held-out blocks"
+    assert paid.reason.startswith(
+        "accepted: test RMSE 1.000 → 1.100 K (+10%) on a test half that is the season's other "
+        "half; ΔBIC -40.0 on the training half, -30.0 over the season"
+    )
+    assert "across held-out blocks: helps in 3 of 3 folds" in paid.reason
+    unpaid = short(-4.0)
+    assert not unpaid.accepted and unpaid.reason.startswith(
+        "rejected: test RMSE 1.000 → 1.100 K (+10%); ΔBIC -40.0 on the training half, -4.0 over "
+        "the season (median of the folds' fits); judged over the season: its input t_ground"
+    )
+    implausible = _finding("ground_coupling", False, short_of_test=True)
+    reject_implausible(implausible, {}, ["mean ground temperature: -20 °C is below any soil"])
+    assert not implausible.short_of_test  # an implausible fit goes no further
 
 
 def test_findings_judged_on_unlike_folds_are_compared_on_the_single_split():
@@ -284,6 +317,17 @@ def test_a_finding_the_training_half_pays_for_beats_one_the_season_pays_for():
     assert not season.accepted and season.lost_to == {
         "effect": "wind_infiltration",
         "reason": "the training half pays for the winner, not for it",
+    }
+
+
+def test_a_finding_the_single_split_s_test_pays_for_beats_one_only_the_season_pays_for():
+    season = _finding("ground_coupling", True, short_of_test=True)
+    season.evidence = _evidence([1, 1, 1], [0.3, 0.3, 0.3])
+    paid = _finding("thermal_mass", True, evidence=_evidence([1, 1, 1], [0.8, 0.8, 0.8]))
+    assert _winner([season, paid], 1) is paid
+    assert season.lost_to == {
+        "effect": "thermal_mass",
+        "reason": "the test half pays for the winner, not for it",
     }
 
 

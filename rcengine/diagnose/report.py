@@ -78,6 +78,7 @@ class Finding:
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
     short_of_bic: bool = False
+    short_of_test: bool = False
     extension: Extension | None = None
     plausible: bool = True
 
@@ -171,6 +172,7 @@ def judge(
     accepted = all(ok for ok, _ in checks)
     failed = [text for ok, text in checks if not ok]
     short_of_bic = not accepted and failed == [checks[1][1]]
+    short_of_test = not accepted and failed == [checks[0][1]]
     reason = (
         "accepted: " + "; ".join(text for _, text in checks)
         if accepted
@@ -203,6 +205,7 @@ def judge(
         detail=detail,
         fit=fit,
         short_of_bic=short_of_bic,
+        short_of_test=short_of_test,
     )
 
 
@@ -246,8 +249,9 @@ def confirm_over_the_season(
     season_bic: float,
 ) -> None:
     """A finding judged on held-out blocks: one short of the training half's BIC alone
-    (``short_of_bic``), or one that passed the single split but whose input is too slow for the
-    rolling folds (``detail[SLOW_INPUT]``: the input and its ``folds.within_fold_share``). It
+    (``short_of_bic``), or one that passed the single split, or fell short of its test alone
+    (``short_of_test``), but whose input is too slow for the rolling folds
+    (``detail[SLOW_INPUT]``: the input and its ``folds.within_fold_share``). It
     passes the BIC where ``season_bic``, its ΔBIC on the blocks' fits over the season around each
     test window, is within the margin, and is then judged as ``confirm_on_folds``."""
     finding.detail["season_delta_bic"] = season_bic
@@ -264,12 +268,17 @@ def confirm_over_the_season(
         if finding.accepted:
             single = finding.reason.removeprefix("accepted: ")
             finding.reason = f"rejected: ΔBIC {season} (single split: {single})"
+        elif finding.short_of_test:
+            finding.reason += f"; ΔBIC {finding.delta_bic:+.1f} on the training half, {season}"
         else:
             finding.reason += f", {season}"
         finding.accepted = False
         return
+    single = _test_change(finding.rmse_test_before, finding.rmse_test_after)
+    if finding.short_of_test:
+        single += " on a test half that is the season's other half"
     finding.reason = (
-        f"accepted: {_test_change(finding.rmse_test_before, finding.rmse_test_after)}; "
+        f"accepted: {single}; "
         f"ΔBIC {finding.delta_bic:+.1f} on the training half, {season}; fitted gain is non-zero"
     )
     confirm_on_folds(finding, evidence, blocks, settings, timezone, HELD_OUT_BLOCKS)
@@ -294,7 +303,7 @@ def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: 
     if not problems:
         return
     text = "implausible: " + "; ".join(problems)
-    finding.short_of_bic = False
+    finding.short_of_bic = finding.short_of_test = False
     finding.plausible = False
     finding.reason = f"rejected as {text}" if finding.accepted else f"{finding.reason}; {text}"
     finding.accepted = False

@@ -964,11 +964,14 @@ def _confirm_on_folds(
     (warm-started from their fits on the whole training period, in one parallel batch) and keep
     only those that help across the folds (``confirm_on_folds``). Under "hybrid" fold training,
     those short of the training half's BIC alone and those whose input is too slow for the
-    rolling folds (``_slow_input``) are judged over the season instead."""
+    rolling folds (``_slow_input``) are judged over the season instead — a slow input also where
+    it fell short of the single split's test alone: fitted on autumn and tested on the spring,
+    the soil's slow course is confounded with every seasonal trend the base model carries (the
+    sun's rise), which the test half then judges rather than the soil."""
     pairs = list(zip(extensions, findings, strict=True))
     if problem.settings.fold_training == "hybrid":
         for e, f in pairs:
-            slow = _slow_input(problem, e, f) if f.accepted else None
+            slow = _slow_input(problem, e, f) if f.accepted or f.short_of_test else None
             if slow is not None:
                 f.detail[SLOW_INPUT] = slow
         _confirm_over_the_season(problem, state, [p for p in pairs if _over_the_season(p[1])])
@@ -996,7 +999,8 @@ def _confirm_on_folds(
 
 def _over_the_season(finding: Finding) -> bool:
     """Whether ``finding`` is judged on the held-out blocks rather than the rolling folds: short
-    of the training half's BIC alone, or with an input too slow for the rolling folds."""
+    of the training half's BIC alone, or with an input too slow for the rolling folds (having
+    passed the single split, or fallen short of its test alone)."""
     return finding.short_of_bic or SLOW_INPUT in finding.detail
 
 
@@ -1291,10 +1295,12 @@ def _winner(confirmed: list[Finding], round_no: int) -> Finding | None:
 
 def _duel(first: Finding, second: Finding) -> tuple[int, str]:
     """Which of two passing findings explains more (0 or 1), and why the other lost."""
-    if first.short_of_bic != second.short_of_bic:
-        # Judged on unlike folds (held-out blocks fit more data): the one the training half
+    short = [f.short_of_bic or f.short_of_test for f in (first, second)]
+    if short[0] != short[1]:
+        # Judged on unlike folds (held-out blocks fit more data): the one the single split
         # pays for comes first, the season's on its own evidence in a later round.
-        return int(first.short_of_bic), "the training half pays for the winner, not for it"
+        half = "training" if (first, second)[short[1]].short_of_bic else "test"
+        return int(short[0]), f"the {half} half pays for the winner, not for it"
     if first.evidence is not None and second.evidence is not None and _alike(first, second):
         return head_to_head(first.evidence, second.evidence)
     winner = 0 if first.improvement_k >= second.improvement_k else 1
