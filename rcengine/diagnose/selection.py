@@ -1299,7 +1299,8 @@ def _duel(first: Finding, second: Finding) -> tuple[int, str]:
     if short[0] != short[1]:
         # Judged on unlike folds (held-out blocks fit more data): the one the single split
         # pays for comes first, the season's on its own evidence in a later round.
-        half = "training" if (first, second)[short[1]].short_of_bic else "test"
+        loser = first if short[0] else second
+        half = "training" if loser.short_of_bic else "test"
         return int(short[0]), f"the {half} half pays for the winner, not for it"
     if first.evidence is not None and second.evidence is not None and _alike(first, second):
         return head_to_head(first.evidence, second.evidence)
