@@ -15,6 +15,8 @@ from rcengine.diagnose.folds import FoldEvidence, rolling_folds
 from rcengine.diagnose.health import Health
 from rcengine.diagnose.html import _fold_tables, _residual_before, render
 from rcengine.diagnose.report import (
+    SHORT_OF_BIC,
+    SHORT_OF_TEST,
     Finding,
     _across,
     confirm_on_folds,
@@ -143,7 +145,7 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
 
     def short(season_bic: float) -> Finding:
         finding = _finding(
-            "window_solar_gains", False, reason="rejected: ΔBIC +9.1", short_of_bic=True
+            "window_solar_gains", False, reason="rejected: ΔBIC +9.1", short_of=SHORT_OF_BIC
         )
         finding.delta_bic = 9.1
         confirm_over_the_season(
@@ -167,9 +169,9 @@ def test_a_finding_short_of_the_bic_alone_is_judged_by_the_bic_over_the_season()
         "rejected: ΔBIC +9.1, -4.0 over the season (median of the folds' fits)"
     )
     assert unpaid.folds["helped"] == 3  # the evidence is reported either way
-    implausible = _finding("window_solar_gains", False, short_of_bic=True)
+    implausible = _finding("window_solar_gains", False, short_of=SHORT_OF_BIC)
     reject_implausible(implausible, {}, ["g-value of the glazing facing 210°: 1.2 exceeds any"])
-    assert not implausible.short_of_bic  # an implausible fit goes no further
+    assert implausible.short_of is None  # an implausible fit goes no further
 
 
 def _slow_ground(season_bic: float, accepted: bool = True, **fields) -> Finding:
@@ -217,7 +219,7 @@ def test_a_slow_input_short_of_the_single_split_s_test_alone_is_judged_over_the_
             False,
             rmse_test_after=1.1,
             reason="rejected: test RMSE 1.000 → 1.100 K (+10%)",
-            short_of_test=True,
+            short_of=SHORT_OF_TEST,
         )
 
     paid = short(-30.0)
@@ -232,9 +234,9 @@ def test_a_slow_input_short_of_the_single_split_s_test_alone_is_judged_over_the_
         "rejected: test RMSE 1.000 → 1.100 K (+10%); ΔBIC -40.0 on the training half, -4.0 over "
         "the season (median of the folds' fits); judged over the season: its input t_ground"
     )
-    implausible = _finding("ground_coupling", False, short_of_test=True)
+    implausible = _finding("ground_coupling", False, short_of=SHORT_OF_TEST)
     reject_implausible(implausible, {}, ["mean ground temperature: -20 °C is below any soil"])
-    assert not implausible.short_of_test  # an implausible fit goes no further
+    assert implausible.short_of is None  # an implausible fit goes no further
 
 
 def test_findings_judged_on_unlike_folds_are_compared_on_the_single_split():
@@ -257,7 +259,7 @@ def test_the_season_does_not_pick_the_way_of_sun_beyond_glass():
 
     def short() -> list:
         return [
-            (None, _finding(e, False, reason="rejected: ΔBIC +9.1", short_of_bic=True))
+            (None, _finding(e, False, reason="rejected: ΔBIC +9.1", short_of=SHORT_OF_BIC))
             for e in ("window_solar_gains", "opaque_solar_gains", "sky_radiation")
         ]
 
@@ -268,7 +270,7 @@ def test_the_season_does_not_pick_the_way_of_sun_beyond_glass():
     kept = _not_the_excess_sun(beyond, 1.4)
     assert [f.effect for _, f in kept] == ["sky_radiation"]
     window = beyond[0][1]
-    assert not window.accepted and not window.short_of_bic
+    assert not window.accepted and window.short_of is None
     assert window.reason == (
         "rejected: ΔBIC +9.1; the model's sun is already beyond glass (as g = 1.40): the "
         "excess-sun step judges which way it comes in"
@@ -310,7 +312,7 @@ def test_a_finding_the_training_half_pays_for_beats_one_the_season_pays_for():
     """Held-out blocks fit more data than a rolling fold: the two findings' fold evidence is
     unlike, and the one the training half's BIC pays for is taken first; the other is judged
     again in a later round, from the model that has it."""
-    season = _finding("sky_radiation", True, short_of_bic=True)
+    season = _finding("sky_radiation", True, short_of=SHORT_OF_BIC)
     season.evidence = _evidence([1, 1, 1], [0.3, 0.3, 0.3])  # far better on its own folds
     paid = _finding("wind_infiltration", True, evidence=_evidence([1, 1, 1], [0.8, 0.8, 0.8]))
     assert _winner([season, paid], 2) is paid
@@ -321,7 +323,7 @@ def test_a_finding_the_training_half_pays_for_beats_one_the_season_pays_for():
 
 
 def test_a_finding_the_single_split_s_test_pays_for_beats_one_only_the_season_pays_for():
-    season = _finding("ground_coupling", True, short_of_test=True)
+    season = _finding("ground_coupling", True, short_of=SHORT_OF_TEST)
     season.evidence = _evidence([1, 1, 1], [0.3, 0.3, 0.3])
     paid = _finding("thermal_mass", True, evidence=_evidence([1, 1, 1], [0.8, 0.8, 0.8]))
     assert _winner([season, paid], 1) is paid

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -37,6 +37,12 @@ MISSING = {
 }
 
 
+# The single split's checks a finding can fall short of alone (``Finding.short_of``).
+ShortOf = Literal["bic", "test"]
+SHORT_OF_BIC: ShortOf = "bic"
+SHORT_OF_TEST: ShortOf = "test"
+
+
 @dataclass
 class Finding:
     """One candidate's verdict. ``rmse_test_after`` is None when it was only screened.
@@ -48,7 +54,10 @@ class Finding:
     candidate; backward: what leaving it out of the final model costs across the folds (the
     backward check of an accepted finding); absent: the values of its new parameters at which it
     is left out (``Extension.absent``); extension: the candidate this verdict is on;
-    plausible: False where a fitted magnitude is implausible for the building.
+    plausible: False where a fitted magnitude is implausible for the building; short_of: the one
+    check of the single split a plausible fit fell short of, where it was the only one —
+    ``SHORT_OF_BIC`` (the training half's BIC) or ``SHORT_OF_TEST`` (the test improvement) — which
+    may send it to be judged over the season (``selection._over_the_season``), else None.
     """
 
     effect: str
@@ -77,8 +86,7 @@ class Finding:
     screen: Screen | None = None
     fit: Fit | None = None
     evidence: FoldEvidence | None = None
-    short_of_bic: bool = False
-    short_of_test: bool = False
+    short_of: ShortOf | None = None
     extension: Extension | None = None
     plausible: bool = True
 
@@ -171,8 +179,8 @@ def judge(
     ]
     accepted = all(ok for ok, _ in checks)
     failed = [text for ok, text in checks if not ok]
-    short_of_bic = not accepted and failed == [checks[1][1]]
-    short_of_test = not accepted and failed == [checks[0][1]]
+    alone: dict[str, ShortOf] = {checks[0][1]: SHORT_OF_TEST, checks[1][1]: SHORT_OF_BIC}
+    short_of = alone.get(failed[0]) if not accepted and len(failed) == 1 else None
     reason = (
         "accepted: " + "; ".join(text for _, text in checks)
         if accepted
@@ -204,8 +212,7 @@ def judge(
         reason=reason,
         detail=detail,
         fit=fit,
-        short_of_bic=short_of_bic,
-        short_of_test=short_of_test,
+        short_of=short_of,
     )
 
 
@@ -249,8 +256,8 @@ def confirm_over_the_season(
     season_bic: float,
 ) -> None:
     """A finding judged on held-out blocks: one short of the training half's BIC alone
-    (``short_of_bic``), or one that passed the single split, or fell short of its test alone
-    (``short_of_test``), but whose input is too slow for the rolling folds
+    (``short_of`` ``SHORT_OF_BIC``), or one that passed the single split, or fell short of its
+    test alone (``SHORT_OF_TEST``), but whose input is too slow for the rolling folds
     (``detail[SLOW_INPUT]``: the input and its ``folds.within_fold_share``). It
     passes the BIC where ``season_bic``, its ΔBIC on the blocks' fits over the season around each
     test window, is within the margin, and is then judged as ``confirm_on_folds``."""
@@ -268,14 +275,14 @@ def confirm_over_the_season(
         if finding.accepted:
             single = finding.reason.removeprefix("accepted: ")
             finding.reason = f"rejected: ΔBIC {season} (single split: {single})"
-        elif finding.short_of_test:
+        elif finding.short_of == SHORT_OF_TEST:
             finding.reason += f"; ΔBIC {finding.delta_bic:+.1f} on the training half, {season}"
         else:
             finding.reason += f", {season}"
         finding.accepted = False
         return
     single = _test_change(finding.rmse_test_before, finding.rmse_test_after)
-    if finding.short_of_test:
+    if finding.short_of == SHORT_OF_TEST:
         single += " on a test half that is the season's other half"
     finding.reason = (
         f"accepted: {single}; "
@@ -303,7 +310,7 @@ def reject_implausible(finding: Finding, magnitudes: dict[str, dict], problems: 
     if not problems:
         return
     text = "implausible: " + "; ".join(problems)
-    finding.short_of_bic = finding.short_of_test = False
+    finding.short_of = None
     finding.plausible = False
     finding.reason = f"rejected as {text}" if finding.accepted else f"{finding.reason}; {text}"
     finding.accepted = False

@@ -92,6 +92,8 @@ from rcengine.diagnose.metered import (
 )
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
+    SHORT_OF_BIC,
+    SHORT_OF_TEST,
     SLOW_INPUT,
     Finding,
     Report,
@@ -625,7 +627,7 @@ def _masked_pair(problem: Problem, state: Selection) -> bool:
     failed = _fails_added_last(problem, trial, [near, partner])
     if failed:
         return _refused(alone_verdict, partner.effect, failed)
-    near.accepted, near.short_of_bic = True, False
+    near.accepted = True
     near.reason = (
         f"accepted with {partner.effect}, which masked it ({near.reason}); on top of "
         f"{partner.effect} alone: {on_top.reason.removeprefix('accepted: ')}"
@@ -971,7 +973,7 @@ def _confirm_on_folds(
     pairs = list(zip(extensions, findings, strict=True))
     if problem.settings.fold_training == "hybrid":
         for e, f in pairs:
-            slow = _slow_input(problem, e, f) if f.accepted or f.short_of_test else None
+            slow = _slow_input(problem, e, f) if f.accepted or f.short_of == SHORT_OF_TEST else None
             if slow is not None:
                 f.detail[SLOW_INPUT] = slow
         _confirm_over_the_season(problem, state, [p for p in pairs if _over_the_season(p[1])])
@@ -1001,7 +1003,7 @@ def _over_the_season(finding: Finding) -> bool:
     """Whether ``finding`` is judged on the held-out blocks rather than the rolling folds: short
     of the training half's BIC alone, or with an input too slow for the rolling folds (having
     passed the single split, or fallen short of its test alone)."""
-    return finding.short_of_bic or SLOW_INPUT in finding.detail
+    return finding.short_of == SHORT_OF_BIC or SLOW_INPUT in finding.detail
 
 
 def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> dict | None:
@@ -1064,10 +1066,10 @@ def _not_the_excess_sun(
         return short
     kept = []
     for ext, finding in short:
-        if not (finding.short_of_bic and finding.effect in EXCESS_EFFECTS):
+        if not (finding.short_of == SHORT_OF_BIC and finding.effect in EXCESS_EFFECTS):
             kept.append((ext, finding))
             continue
-        finding.short_of_bic = False
+        finding.short_of = None
         finding.reason += (
             f"; the model's sun is already beyond glass (as g = {g:.2f}): the excess-sun step "
             "judges which way it comes in"
@@ -1295,12 +1297,12 @@ def _winner(confirmed: list[Finding], round_no: int) -> Finding | None:
 
 def _duel(first: Finding, second: Finding) -> tuple[int, str]:
     """Which of two passing findings explains more (0 or 1), and why the other lost."""
-    short = [f.short_of_bic or f.short_of_test for f in (first, second)]
+    short = [f.short_of is not None for f in (first, second)]
     if short[0] != short[1]:
         # Judged on unlike folds (held-out blocks fit more data): the one the single split
         # pays for comes first, the season's on its own evidence in a later round.
         loser = first if short[0] else second
-        half = "training" if loser.short_of_bic else "test"
+        half = "training" if loser.short_of == SHORT_OF_BIC else "test"
         return int(short[0]), f"the {half} half pays for the winner, not for it"
     if first.evidence is not None and second.evidence is not None and _alike(first, second):
         return head_to_head(first.evidence, second.evidence)
