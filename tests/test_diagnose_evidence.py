@@ -239,6 +239,34 @@ def test_a_slow_input_short_of_the_single_split_s_test_alone_is_judged_over_the_
     assert implausible.short_of is None  # an implausible fit goes no further
 
 
+def test_a_gain_the_rolling_folds_rejected_is_judged_over_the_season_with_the_heater_off():
+    """A plug load that passed the single split but not the rolling folds, while the heater held
+    the set point, is judged on held-out blocks once it forecasts the hours with the heater off
+    better; the reason names those hours' figures and keeps the single split's."""
+    folds = rolling_folds(
+        pd.date_range("2017-01-01", "2017-03-01", freq="1h", tz="UTC"), "Europe/Rome", 14, 7, 3
+    )
+
+    def judged(season_bic: float) -> Finding:
+        finding = _finding("unmetered_gains", True, delta_bic=-100.7)
+        off = {"signal": "sched_gains", "hours": 558.0, "rmse_before": 0.433, "rmse_after": 0.219}
+        finding.detail["heater_off"] = off
+        helps = _evidence([1, 1, 1], [0.6, 0.7, 0.8])
+        confirm_over_the_season(
+            finding, helps, folds, DiagnoseSettings(), "Europe/Rome", season_bic
+        )
+        return finding
+
+    paid = judged(-137.6)
+    assert paid.accepted and paid.folds["training"] == "held-out blocks"
+    assert (
+        "judged over the season: over the 558 h of its schedule with the heater off, it "
+        "forecasts 0.433 → 0.219 K" in paid.reason
+    )
+    unpaid = judged(-4.0)
+    assert not unpaid.accepted and unpaid.reason.startswith("rejected: ΔBIC -4.0 over the season")
+
+
 def test_findings_judged_on_unlike_folds_are_compared_on_the_single_split():
     """A ground judged on held-out blocks and a gain judged on rolling folds, both paid for by
     the training half: the blocks' fits span the season and err less, so the two are compared on

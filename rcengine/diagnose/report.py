@@ -131,6 +131,9 @@ HELD_OUT_BLOCKS = "held-out blocks"
 # A finding's ``detail`` key for the input too slow for the rolling folds that sent it to the
 # held-out blocks (``selection._slow_input``): {"signal", "within_fold_share"}.
 SLOW_INPUT = "slow_input"
+# A gain the rolling folds rejected, judged on the held-out blocks for what it forecasts with
+# the heater off (``selection._gains_over_the_season``): ``heater_off.heater_off_change``.
+HEATER_OFF = "heater_off"
 
 
 def _test_change(before: float, after: float) -> str:
@@ -264,6 +267,12 @@ def confirm_over_the_season(
     finding.detail["season_delta_bic"] = season_bic
     season = f"{season_bic:+.1f} over the season (median of the folds' fits)"
     slow = finding.detail.get(SLOW_INPUT)
+    off = finding.detail.get(HEATER_OFF)
+    if off is not None:
+        season += (
+            f"; judged over the season: over the {off['hours']:.0f} h of its schedule with the "
+            f"heater off, it forecasts {off['rmse_before']:.3f} → {off['rmse_after']:.3f} K"
+        )
     if slow is not None:
         season += (
             f"; judged over the season: its input {slow['signal']} varies within a fold's "

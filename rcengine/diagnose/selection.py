@@ -83,6 +83,7 @@ from rcengine.diagnose.health import (
     on_bounds,
     relaxed_bounds,
 )
+from rcengine.diagnose.heater_off import heater_off_change
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.metered import (
     F_LIGHT_AIR,
@@ -92,6 +93,7 @@ from rcengine.diagnose.metered import (
 )
 from rcengine.diagnose.plausibility import assess
 from rcengine.diagnose.report import (
+    HEATER_OFF,
     SHORT_OF_BIC,
     SHORT_OF_TEST,
     SLOW_INPUT,
@@ -988,6 +990,7 @@ def _confirm_on_folds(
     problem.say(f"  confirming {', '.join(names)} on {len(problem.folds)} rolling folds")
     fits = _fold_fits_beside_current(problem, state, models)
     before = tuple(f.residual_test for f in state.current_folds)
+    single = {id(f): f.reason for _, f in passing}
     for (_, finding), fold_fits in zip(passing, fits, strict=True):
         after = tuple(f.residual_test for f in fold_fits)
         confirm_on_folds(
@@ -997,6 +1000,9 @@ def _confirm_on_folds(
             problem.settings,
             problem.building.location.timezone,
         )
+    gains = [(e, f, single[id(f)]) for e, f in passing if e.effect == "unmetered_gains"]
+    if problem.settings.fold_training == "hybrid" and not any(f.accepted for _, f, _ in gains):
+        _gains_over_the_season(problem, state, gains)
 
 
 def _over_the_season(finding: Finding) -> bool:
@@ -1004,6 +1010,12 @@ def _over_the_season(finding: Finding) -> bool:
     of the training half's BIC alone, or with an input too slow for the rolling folds (having
     passed the single split, or fallen short of its test alone)."""
     return finding.short_of == SHORT_OF_BIC or SLOW_INPUT in finding.detail
+
+
+def _season_judged(finding: Finding) -> bool:
+    """Whether ``finding`` was accepted on the held-out blocks for what the rolling folds cannot
+    judge: an input too slow for them, or a gain they rejected that holds with the heater off."""
+    return SLOW_INPUT in finding.detail or HEATER_OFF in finding.detail
 
 
 def _slow_input(problem: Problem, ext: Extension, finding: Finding) -> dict | None:
@@ -1034,6 +1046,34 @@ def _confirm_over_the_season(
     judged = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
     if not judged:
         return
+    blocks, fits = _block_fits(problem, state, [(e, f) for e, f in judged])
+    for (_, finding), fold_fits in zip(judged, fits, strict=True):
+        _judge_on_blocks(problem, state, finding, blocks, fold_fits)
+
+
+def _judge_on_blocks(
+    problem: Problem, state: Selection, finding: Finding, blocks: list[Fold], fits: list[Fit]
+) -> None:
+    """``confirm_over_the_season`` of ``finding`` by its ``fits`` on the held-out ``blocks``
+    against the current model's (``state.current_blocks``)."""
+    confirm_over_the_season(
+        finding,
+        FoldEvidence(
+            tuple(f.residual_test for f in state.current_blocks),
+            tuple(f.residual_test for f in fits),
+        ),
+        blocks,
+        problem.settings,
+        problem.building.location.timezone,
+        _season_bic(state.current_blocks, fits),
+    )
+
+
+def _block_fits(
+    problem: Problem, state: Selection, pairs: list[tuple[Extension, Finding]]
+) -> tuple[list[Fold], list[list[Fit]]]:
+    """The held-out blocks and each extension's fits on them (``_fold_fits``); the current
+    model's too, once, kept in ``state.current_blocks``."""
     blocks = held_out_blocks(problem.folds, problem.frame.index)
     seasonal = replace(problem, folds=blocks)
     if state.current_blocks is None:
@@ -1041,17 +1081,40 @@ def _confirm_over_the_season(
         (state.current_blocks,) = _fold_fits(
             seasonal, [(current.network, current.options, current.params)]
         )
-    fits = _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in judged])
-    before = tuple(f.residual_test for f in state.current_blocks)
-    for (_, finding), fold_fits in zip(judged, fits, strict=True):
-        confirm_over_the_season(
-            finding,
-            FoldEvidence(before, tuple(f.residual_test for f in fold_fits)),
-            blocks,
-            problem.settings,
-            problem.building.location.timezone,
-            _season_bic(state.current_blocks, fold_fits),
+    return blocks, _fold_fits(seasonal, [(e.network, e.signals, f.fit.params) for e, f in pairs])
+
+
+def _gains_over_the_season(
+    problem: Problem, state: Selection, rejected: list[tuple[Extension, Finding, str]]
+) -> None:
+    """Unmetered gains that passed the single split (``rejected``: each version with that
+    verdict's reason) but not the rolling folds, none of their versions, judged again on the
+    held-out blocks (``confirm_over_the_season``) where they forecast the blocks' hours with the
+    heater off better, by the relative margin (``heater_off``). A version the rolling folds
+    passed is the effect's: the blocks' errors, fitted on more of the record, are no measure
+    against the folds' in choosing between versions (``_one_version_each``).
+
+    While the heater holds the set point, a missing gain shows only in the heat it no longer
+    gives, which a lower envelope conductance asks as well over a fold's four weeks; the two part
+    as the indoor–outdoor difference moves over the season. The hours with the heater off keep
+    out what stands in for the heater's own timing (an emitter's lag), which the season alone
+    would take."""
+    if not rejected:
+        return
+    blocks, fits = _block_fits(problem, state, [(e, f) for e, f, _ in rejected])
+    margin = 1.0 - problem.settings.min_improvement
+    for (ext, finding, split_reason), fold_fits in zip(rejected, fits, strict=True):
+        off = heater_off_change(state.current_blocks, fold_fits, ext.inputs[0][0])
+        if off is None or off["rmse_after"] > margin * off["rmse_before"]:
+            continue
+        finding.detail[HEATER_OFF] = off
+        problem.say(
+            f"  judging {ext.effect} over the season: with the heater off it forecasts "
+            f"{off['rmse_before']:.3f} → {off['rmse_after']:.3f} K over {off['hours']:.0f} h"
         )
+        finding.accepted, rolling, finding.reason = True, finding.reason, split_reason
+        _judge_on_blocks(problem, state, finding, blocks, fold_fits)
+        finding.reason += f" (the rolling folds: {rolling.removeprefix('rejected across folds: ')})"
 
 
 def _not_the_excess_sun(
@@ -1145,9 +1208,10 @@ def _backward(problem: Problem, state: Selection) -> None:
     one that matters most first. Steps taken to make the base model healthy are not candidates
     and stay first. A finding accepted on other evidence than the rolling folds (the opaque sun,
     from what the declared glazing admits beyond glass, ``excess_sun``; an input too slow for
-    them, judged over the season, ``_slow_input``) is ordered with the others but not dropped by
-    them; the opaque sun is checked after it too, since a finding taken before it may have stood
-    in for its sun.
+    them, judged over the season, ``_slow_input``; a gain they rejected that holds with the
+    heater off, ``_gains_over_the_season``) is ordered with the others but not dropped by them;
+    the opaque sun is checked after it too, since a finding taken before it may have stood in
+    for its sun.
     """
     rule = problem.settings.fold_rule
     while problem.folds:
@@ -1162,7 +1226,7 @@ def _backward(problem: Problem, state: Selection) -> None:
             ok, text = judge_folds(ev, rule)
             worth[finding.effect] = ev.pooled_before - ev.pooled_after
             finding.backward = _added_last(problem, ev, text, still_needed=ok)
-            if not ok and finding.evidence is not None and SLOW_INPUT not in finding.detail:
+            if not ok and finding.evidence is not None and not _season_judged(finding):
                 failing.append(finding)
         state.accepted.sort(key=lambda f: (not f.baseline_repair, -worth.get(f.effect, 0.0)))
         if not failing:
