@@ -1046,7 +1046,7 @@ def _confirm_over_the_season(
     judged = _not_the_excess_sun(season, sun_as_glazing_g(state.current))
     if not judged:
         return
-    blocks, fits = _block_fits(problem, state, [(e, f) for e, f in judged])
+    blocks, fits = _block_fits(problem, state, judged)
     for (_, finding), fold_fits in zip(judged, fits, strict=True):
         _judge_on_blocks(problem, state, finding, blocks, fold_fits)
 
