@@ -21,6 +21,31 @@ def _block(frame: pd.DataFrame, residual: np.ndarray) -> SimpleNamespace:
     return SimpleNamespace(residual_test=residual, split=SimpleNamespace(test=test))
 
 
+def _off(frame: pd.DataFrame) -> pd.Series:
+    return pd.Series(off_rows(frame), index=frame.index)
+
+
+def test_a_block_s_first_hours_are_read_with_the_heat_given_before_it():
+    """A held-out block that begins an hour after the heater stopped (on through 05:00, the
+    block from 06:00): its 07:00 is not yet three hours free of that heat, though the block's own
+    rows show none. Read against the whole record it is left out, and the hours counted are
+    08:00 on; read from the block alone, 07:00 would count, with the error the heat left."""
+    schedule = np.ones(24)
+    heating = np.where(np.arange(24) <= 5, 2000.0, 0.0)
+    record = _frame(24, heating, schedule)
+    block = record.iloc[6:]
+    cold, fixed = np.full(len(block), 0.5), np.full(len(block), 0.1)
+    fixed[:2] = 2.0  # wrong only in the hours the heater's heat still shows
+    blocks = [_block(block, cold)], [_block(block, fixed)]
+    change = heater_off_change(*blocks, SIGNAL, _off(record))
+    assert change is not None
+    assert change["hours"] == pytest.approx(16.0)  # 08:00–23:00
+    assert change["rmse_after"] == pytest.approx(0.1)
+    alone = heater_off_change(*blocks, SIGNAL, _off(block))
+    assert alone is not None and alone["hours"] == pytest.approx(17.0)
+    assert alone["rmse_after"] == pytest.approx(np.sqrt((2.0**2 + 16 * 0.1**2) / 17))
+
+
 def test_rows_count_only_once_the_heater_has_been_off_long_enough():
     heating = np.where(np.arange(24) <= 5, 2000.0, 0.0)
     off = off_rows(_frame(24, heating, np.ones(24)))
@@ -37,7 +62,7 @@ def test_a_gain_that_warms_the_free_floating_hours_forecasts_them_better():
     frame = _frame(hours, heating, schedule)
     cold = np.where(schedule > 0, 0.8, 0.1)  # measured − simulated [K]: the model runs cold
     fixed = np.where(schedule > 0, 0.1, 0.1)
-    change = heater_off_change([_block(frame, cold)], [_block(frame, fixed)], SIGNAL)
+    change = heater_off_change([_block(frame, cold)], [_block(frame, fixed)], SIGNAL, _off(frame))
     assert change is not None
     # Heating through 06:00; the occupied rows 3 h free of its heat are 09:00–17:00, 9 a day.
     assert change["hours"] == pytest.approx(18.0)
@@ -52,7 +77,8 @@ def test_too_few_heater_off_hours_on_the_schedule_judge_nothing():
     frame = _frame(hours, heating, schedule)
     residual = np.full(hours, 0.5)
     assert MIN_OFF_HOURS > 0
-    assert heater_off_change([_block(frame, residual)], [_block(frame, residual)], SIGNAL) is None
+    blocks = [_block(frame, residual)], [_block(frame, residual)]
+    assert heater_off_change(*blocks, SIGNAL, _off(frame)) is None
 
 
 def test_only_a_gain_that_holds_with_the_heater_off_goes_over_the_season(monkeypatch):
@@ -76,7 +102,7 @@ def test_only_a_gain_that_holds_with_the_heater_off_goes_over_the_season(monkeyp
     monkeypatch.setattr(
         selection, "_judge_on_blocks", lambda p, s, finding, *_: judged.append(finding.effect)
     )
-    problem = SimpleNamespace(settings=DiagnoseSettings(), say=lambda _: None)
+    problem = SimpleNamespace(settings=DiagnoseSettings(), say=lambda _: None, frame=frame)
     state = SimpleNamespace(current_blocks=[current])
     ext = SimpleNamespace(effect="unmetered_gains", inputs=((SIGNAL, "t_air"),))
     rolling = "rejected across folds: helps in 2 of 5 folds"
@@ -91,3 +117,54 @@ def test_only_a_gain_that_holds_with_the_heater_off_goes_over_the_season(monkeyp
     assert plug_load.reason.endswith("(the rolling folds: helps in 2 of 5 folds)")
     assert HEATER_OFF not in stand_in.detail and stand_in.reason == rolling
     assert not stand_in.accepted
+
+
+@pytest.mark.parametrize("folds_pass", [(True, False), (False, False)])
+def test_no_version_goes_over_the_season_where_the_rolling_folds_pass_one(monkeypatch, folds_pass):
+    """Two versions of a gain (a learnt schedule and its refinement) pass the single split. Where
+    the rolling folds pass either, neither is sent to the held-out blocks: the blocks' errors,
+    fitted on more of the record, are no measure against the folds' in choosing between
+    versions. Where the folds reject both, both go, each with the single split's reason."""
+    from rcengine.diagnose import selection
+    from rcengine.diagnose.settings import DiagnoseSettings
+
+    split_reason = "accepted: test RMSE 1.000 → 0.500 K (-50%)"
+    versions = [
+        SimpleNamespace(effect="unmetered_gains", network=None, signals=None) for _ in range(2)
+    ]
+    findings = [
+        SimpleNamespace(
+            effect="unmetered_gains",
+            accepted=True,
+            reason=split_reason,
+            short_of=None,
+            detail={},
+            fit=SimpleNamespace(params={}),
+        )
+        for _ in range(2)
+    ]
+    verdicts = dict(zip(map(id, findings), folds_pass, strict=True))
+
+    def rolling(finding, *_):
+        finding.accepted = verdicts[id(finding)]
+        finding.reason = "accepted across folds" if finding.accepted else "rejected across folds"
+
+    sent = []
+    monkeypatch.setattr(selection, "_slow_input", lambda *_: None)
+    monkeypatch.setattr(selection, "_confirm_over_the_season", lambda *_: None)
+    monkeypatch.setattr(selection, "_fold_fits_beside_current", lambda p, s, m: [[]] * len(m))
+    monkeypatch.setattr(selection, "confirm_on_folds", rolling)
+    monkeypatch.setattr(selection, "_gains_over_the_season", lambda p, s, gains: sent.extend(gains))
+    problem = SimpleNamespace(
+        settings=DiagnoseSettings(),
+        folds=[object()] * 5,
+        building=SimpleNamespace(location=SimpleNamespace(timezone="UTC")),
+        say=lambda _: None,
+    )
+    state = SimpleNamespace(current_folds=[])
+    selection._confirm_on_folds(problem, state, versions, findings)
+    if any(folds_pass):
+        assert sent == []
+    else:
+        assert [(e, f) for e, f, _ in sent] == list(zip(versions, findings, strict=True))
+        assert all(reason == split_reason for _, _, reason in sent)

@@ -37,17 +37,21 @@ def off_rows(frame: pd.DataFrame, off_for_h: float = OFF_FOR_H) -> np.ndarray:
     return (recent.to_numpy() == 0.0) & (np.arange(len(frame)) > 0)
 
 
-def heater_off_change(current: list[Fit], extended: list[Fit], signal: str) -> dict | None:
+def heater_off_change(
+    current: list[Fit], extended: list[Fit], signal: str, heater_off: pd.Series
+) -> dict | None:
     """The test RMSE [K] of the ``current`` model and of the ``extended`` one (with the gain),
     pooled over the held-out blocks' test rows where the gain's input ``signal`` is on and the
-    heater has been off ``OFF_FOR_H`` hours; None where those rows add up to fewer than
-    ``MIN_OFF_HOURS``."""
+    heater has been off ``OFF_FOR_H`` hours (``heater_off``: ``off_rows`` of the whole record,
+    by time, so that a block's first hours are read with the heat given before the block
+    began); None where those rows add up to fewer than ``MIN_OFF_HOURS``."""
     before, after = [], []
     hours = 0.0
     for c, e in zip(current, extended, strict=True):
         test = e.split.test
         frame = test.frame
-        rows = off_rows(frame) & (np.nan_to_num(frame[signal].to_numpy(dtype=float)) > 0.0)
+        off = heater_off.reindex(frame.index, fill_value=False).to_numpy(dtype=bool)
+        rows = off & (np.nan_to_num(frame[signal].to_numpy(dtype=float)) > 0.0)
         rows &= np.isfinite(c.residual_test) & np.isfinite(e.residual_test)
         before.append(c.residual_test[rows])
         after.append(e.residual_test[rows])

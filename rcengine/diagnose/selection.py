@@ -83,7 +83,7 @@ from rcengine.diagnose.health import (
     on_bounds,
     relaxed_bounds,
 )
-from rcengine.diagnose.heater_off import heater_off_change
+from rcengine.diagnose.heater_off import heater_off_change, off_rows
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.metered import (
     F_LIGHT_AIR,
@@ -1103,8 +1103,9 @@ def _gains_over_the_season(
         return
     blocks, fits = _block_fits(problem, state, [(e, f) for e, f, _ in rejected])
     margin = 1.0 - problem.settings.min_improvement
+    heater_off = pd.Series(off_rows(problem.frame), index=problem.frame.index)
     for (ext, finding, split_reason), fold_fits in zip(rejected, fits, strict=True):
-        off = heater_off_change(state.current_blocks, fold_fits, ext.inputs[0][0])
+        off = heater_off_change(state.current_blocks, fold_fits, ext.inputs[0][0], heater_off)
         if off is None or off["rmse_after"] > margin * off["rmse_before"]:
             continue
         finding.detail[HEATER_OFF] = off
