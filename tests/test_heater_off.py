@@ -21,10 +21,6 @@ def _block(frame: pd.DataFrame, residual: np.ndarray) -> SimpleNamespace:
     return SimpleNamespace(residual_test=residual, split=SimpleNamespace(test=test))
 
 
-def _off(frame: pd.DataFrame) -> pd.Series:
-    return pd.Series(off_rows(frame), index=frame.index)
-
-
 def test_a_block_s_first_hours_are_read_with_the_heat_given_before_it():
     """A held-out block that begins an hour after the heater stopped (on through 05:00, the
     block from 06:00): its 07:00 is not yet three hours free of that heat, though the block's own
@@ -37,11 +33,11 @@ def test_a_block_s_first_hours_are_read_with_the_heat_given_before_it():
     cold, fixed = np.full(len(block), 0.5), np.full(len(block), 0.1)
     fixed[:2] = 2.0  # wrong only in the hours the heater's heat still shows
     blocks = [_block(block, cold)], [_block(block, fixed)]
-    change = heater_off_change(*blocks, SIGNAL, _off(record))
+    change = heater_off_change(*blocks, SIGNAL, off_rows(record))
     assert change is not None
     assert change["hours"] == pytest.approx(16.0)  # 08:00–23:00
     assert change["rmse_after"] == pytest.approx(0.1)
-    alone = heater_off_change(*blocks, SIGNAL, _off(block))
+    alone = heater_off_change(*blocks, SIGNAL, off_rows(block))
     assert alone is not None and alone["hours"] == pytest.approx(17.0)
     assert alone["rmse_after"] == pytest.approx(np.sqrt((2.0**2 + 16 * 0.1**2) / 17))
 
@@ -51,8 +47,8 @@ def test_rows_count_only_once_the_heater_has_been_off_long_enough():
     off = off_rows(_frame(24, heating, np.ones(24)))
     # On through 05:00; the first row with OFF_FOR_H hours free of its heat is 05:00 + 3 h.
     assert OFF_FOR_H == 3.0
-    assert not off[:8].any()
-    assert off[8:].all()
+    assert not off.iloc[:8].any()
+    assert off.iloc[8:].all()
 
 
 def test_a_gain_that_warms_the_free_floating_hours_forecasts_them_better():
@@ -62,7 +58,8 @@ def test_a_gain_that_warms_the_free_floating_hours_forecasts_them_better():
     frame = _frame(hours, heating, schedule)
     cold = np.where(schedule > 0, 0.8, 0.1)  # measured − simulated [K]: the model runs cold
     fixed = np.where(schedule > 0, 0.1, 0.1)
-    change = heater_off_change([_block(frame, cold)], [_block(frame, fixed)], SIGNAL, _off(frame))
+    blocks = [_block(frame, cold)], [_block(frame, fixed)]
+    change = heater_off_change(*blocks, SIGNAL, off_rows(frame))
     assert change is not None
     # Heating through 06:00; the occupied rows 3 h free of its heat are 09:00–17:00, 9 a day.
     assert change["hours"] == pytest.approx(18.0)
@@ -78,7 +75,7 @@ def test_too_few_heater_off_hours_on_the_schedule_judge_nothing():
     residual = np.full(hours, 0.5)
     assert MIN_OFF_HOURS > 0
     blocks = [_block(frame, residual)], [_block(frame, residual)]
-    assert heater_off_change(*blocks, SIGNAL, _off(frame)) is None
+    assert heater_off_change(*blocks, SIGNAL, off_rows(frame)) is None
 
 
 def test_only_a_gain_that_holds_with_the_heater_off_goes_over_the_season(monkeypatch):

@@ -27,14 +27,15 @@ OFF_FOR_H = 3.0
 MIN_OFF_HOURS = 8.0
 
 
-def off_rows(frame: pd.DataFrame, off_for_h: float = OFF_FOR_H) -> np.ndarray:
-    """Rows whose heater output ``q_hvac`` [W] has been zero (no heating) over the last
-    ``off_for_h`` hours, the row itself included."""
+def off_rows(frame: pd.DataFrame, off_for_h: float = OFF_FOR_H) -> pd.Series:
+    """Per row (by time), whether the heater output ``q_hvac`` [W] has been zero (no heating)
+    over the last ``off_for_h`` hours, the row itself included; the first row, without a
+    history, is not."""
     if Q_HVAC not in frame.columns:
-        return np.zeros(len(frame), dtype=bool)
+        return pd.Series(False, index=frame.index)
     heating = pd.Series(np.nan_to_num(frame[Q_HVAC].to_numpy(dtype=float)) > 0.0, frame.index)
     recent = heating.astype(float).rolling(pd.Timedelta(hours=off_for_h)).max()
-    return (recent.to_numpy() == 0.0) & (np.arange(len(frame)) > 0)
+    return (recent == 0.0) & (np.arange(len(frame)) > 0)
 
 
 def heater_off_change(

@@ -1103,7 +1103,7 @@ def _gains_over_the_season(
         return
     blocks, fits = _block_fits(problem, state, [(e, f) for e, f, _ in rejected])
     margin = 1.0 - problem.settings.min_improvement
-    heater_off = pd.Series(off_rows(problem.frame), index=problem.frame.index)
+    heater_off = off_rows(problem.frame)
     for (ext, finding, split_reason), fold_fits in zip(rejected, fits, strict=True):
         off = heater_off_change(state.current_blocks, fold_fits, ext.inputs[0][0], heater_off)
         if off is None or off["rmse_after"] > margin * off["rmse_before"]:
