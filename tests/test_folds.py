@@ -226,6 +226,22 @@ def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
     assert _one_version_each([first, refined]) == [refined]
 
 
+def test_versions_judged_on_unlike_folds_are_ranked_by_their_relative_cut():
+    """A version judged on the held-out blocks (fitted on most of the record, so lower errors)
+    against one judged on the rolling folds: the larger relative cut wins, not the lower RMSE."""
+    rolling = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 1.0, 0.8)
+    blocks = _version("unmetered_gains", "", 1.0, 0.45)
+    blocks.detail = {"follows": "q_occ + q_light"}
+    blocks.evidence = _evidence([0.5] * 5, [0.45] * 5)
+    assert blocks.evidence.pooled_after < rolling.evidence.pooled_after
+    assert _one_version_each([blocks, rolling]) == [rolling]
+    assert rolling.detail["use_not_taken"] == "0.450 K pooled over the folds"
+    # Folds with no error to cut (a noiseless record) rank the version as unjudged, not a crash.
+    exact = _version("unmetered_gains", "Mon–Fri 07:00–17:00", 1.0, 0.0)
+    exact.evidence = _evidence([0.0] * 5, [0.0] * 5)
+    assert _one_version_each([exact, rolling]) == [rolling]
+
+
 def test_the_folds_choose_between_a_learnt_schedule_and_the_metered_use():
     """An unmetered gain on a learnt schedule and one in step with the metered use are two
     versions of one effect: the one the folds favour is kept, the other named."""

@@ -848,13 +848,20 @@ NOT_TAKEN = "_not_taken"
 
 
 def _one_version_each(findings: list[Finding]) -> list[Finding]:
-    """Per effect, the version the evidence favours: accepted before rejected, then the lower
-    pooled test RMSE across the folds (where they judge), then the better training fit; the other
-    is named in its detail."""
+    """Per effect, the version the evidence favours: accepted before rejected, then the larger
+    relative cut of the pooled test RMSE across its folds (where they judge), then the better
+    training fit; the other is named in its detail.
+
+    The cut is relative because two versions can be judged on unlike folds — one on the rolling
+    folds' four weeks of training, another on the held-out blocks fitted on the rest of the
+    record — whose errors are no measure of one another; on the same folds it orders them as
+    their pooled test RMSEs do."""
 
     def rank(f: Finding) -> tuple[bool, float, float]:
-        pooled = f.evidence.pooled_after if f.evidence is not None else float("inf")
-        return (not f.accepted, pooled, f.fit.sse_train)
+        e = f.evidence
+        judged = e is not None and e.pooled_before > 0.0
+        kept = e.pooled_after / e.pooled_before if judged else float("inf")
+        return (not f.accepted, kept, f.fit.sse_train)
 
     chosen: dict[str, Finding] = {}
     for f in findings:
