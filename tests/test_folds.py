@@ -219,7 +219,9 @@ def test_the_folds_choose_between_a_learnt_schedule_and_its_refinement():
     refined = _version("unmetered_gains", "Mon–Fri 07:00–17:00", 1.0, 0.9)
     chosen = _one_version_each([first, other, refined])
     assert chosen == [first, other]
-    assert first.detail["schedule_not_taken"] == "Mon–Fri 07:00–17:00 (0.900 K)"
+    assert first.detail["schedule_not_taken"] == (
+        "Mon–Fri 07:00–17:00: pooled test RMSE 1.000 → 0.900 K (-10%) on its folds"
+    )
     # A version the folds reject loses to one they accept, whatever its pooled test.
     first, refined = (_version("unmetered_gains", s, 1.0, 0.8) for s in ("a", "b"))
     first.accepted = False
@@ -235,7 +237,7 @@ def test_versions_judged_on_unlike_folds_are_ranked_by_their_relative_cut():
     blocks.evidence = _evidence([0.5] * 5, [0.45] * 5)
     assert blocks.evidence.pooled_after < rolling.evidence.pooled_after
     assert _one_version_each([blocks, rolling]) == [rolling]
-    assert rolling.detail["use_not_taken"] == "0.450 K pooled over the folds"
+    assert rolling.detail["use_not_taken"] == "pooled test RMSE 0.500 → 0.450 K (-10%) on its folds"
     # Folds with no error to cut (a noiseless record) rank the version as unjudged, not a crash.
     exact = _version("unmetered_gains", "Mon–Fri 07:00–17:00", 1.0, 0.0)
     exact.evidence = _evidence([0.0] * 5, [0.0] * 5)
@@ -249,10 +251,14 @@ def test_the_folds_choose_between_a_learnt_schedule_and_the_metered_use():
     use = _version("unmetered_gains", "", 2.0, 0.6)
     use.detail = {"follows": "q_occ + q_light"}
     assert _one_version_each([learnt, use]) == [use]
-    assert use.detail["schedule_not_taken"] == "Mon–Fri 15:00–19:00 (0.800 K)"
+    assert use.detail["schedule_not_taken"] == (
+        "Mon–Fri 15:00–19:00: pooled test RMSE 1.000 → 0.800 K (-20%) on its folds"
+    )
     better_learnt = _version("unmetered_gains", "Mon–Fri 08:00–17:00", 1.0, 0.5)
     assert _one_version_each([better_learnt, use]) == [better_learnt]
-    assert better_learnt.detail["use_not_taken"] == "0.600 K pooled over the folds"
+    assert better_learnt.detail["use_not_taken"] == (
+        "pooled test RMSE 1.000 → 0.600 K (-40%) on its folds"
+    )
 
 
 def test_the_folds_choose_whether_an_unmetered_gain_has_a_base_load():
@@ -264,16 +270,16 @@ def test_the_folds_choose_whether_an_unmetered_gain_has_a_base_load():
     with_base.detail = {"follows": "q_occ + q_light", "base_load": True}
     assert _one_version_each([use, with_base]) == [with_base]
     assert with_base.detail["no_base_load_not_taken"] == (
-        "in step with q_occ + q_light: 0.600 K pooled over the folds"
+        "in step with q_occ + q_light: pooled test RMSE 1.000 → 0.600 K (-40%) on its folds"
     )
     learnt = _version("unmetered_gains", "Mon–Fri 08:00–18:00", 1.0, 0.3)
     assert _one_version_each([with_base, learnt]) == [learnt]
     assert learnt.detail["base_load_not_taken"] == (
-        "in step with q_occ + q_light: 0.400 K pooled over the folds"
+        "in step with q_occ + q_light: pooled test RMSE 1.000 → 0.400 K (-60%) on its folds"
     )
     # The version the base-load one had beaten stays named after both lost.
     assert learnt.detail["no_base_load_not_taken"] == (
-        "in step with q_occ + q_light: 0.600 K pooled over the folds"
+        "in step with q_occ + q_light: pooled test RMSE 1.000 → 0.600 K (-40%) on its folds"
     )
 
 
@@ -607,7 +613,7 @@ def test_the_soil_s_lag_is_the_version_the_evidence_takes():
     assert _one_version_each([month, deeper]) == [deeper]
     assert deeper.detail["ground_lag_not_taken"] == (
         "1.5 months (rejected as implausible: U-value of the ground floor: 2.27 W/(m²K)); "
-        "1.0 months (0.800 K pooled over the folds)"
+        "1.0 months (pooled test RMSE 1.000 → 0.800 K (-20%) on its folds)"
     )
 
 
@@ -623,7 +629,7 @@ def test_every_ground_version_not_taken_is_named():
         versions.append(version)
     assert _one_version_each(versions) == [versions[2]]
     assert versions[2].detail["ground_lag_not_taken"].split("; ") == [
-        "1.0 months (0.800 K pooled over the folds)",
-        "1.5 months (0.700 K pooled over the folds)",
-        "1.5 months through 1.2 m of soil (0.600 K pooled over the folds)",
+        "1.0 months (pooled test RMSE 1.000 → 0.800 K (-20%) on its folds)",
+        "1.5 months (pooled test RMSE 1.000 → 0.700 K (-30%) on its folds)",
+        "1.5 months through 1.2 m of soil (pooled test RMSE 1.000 → 0.600 K (-40%) on its folds)",
     ]

@@ -149,6 +149,13 @@ class FoldEvidence:
     def pooled_after(self) -> float:
         return _rmse(np.concatenate(self.after))
 
+    def pooled_words(self) -> str:
+        """The pooled test RMSE before → after and its relative change (none where nothing was
+        left to cut)."""
+        before, after = self.pooled_before, self.pooled_after
+        change = f" ({(after - before) / before:+.0%})" if before > 0.0 else ""
+        return f"pooled test RMSE {before:.3f} → {after:.3f} K{change}"
+
     @property
     def tied(self) -> np.ndarray:
         """Per fold: did the extension move the test RMSE by less than ``FOLD_TIE_SHARE``?"""
@@ -240,14 +247,10 @@ def judge_folds(evidence: FoldEvidence, rule: FoldRule) -> tuple[bool, str]:
     n, k = evidence.decided, int(evidence.helped.sum())
     ties = len(evidence.before) - n
     before, after = evidence.pooled_before, evidence.pooled_after
-    gain = before - after
     tied = f" ({ties} more tied)" if ties else ""
     checks = [
         (n > 0 and k > rule.min_share * n, f"helps in {k} of {n} folds{tied}"),
-        (
-            gain >= rule.min_improvement * before,
-            f"pooled test RMSE {before:.3f} → {after:.3f} K ({-gain / before:+.0%})",
-        ),
+        (before - after >= rule.min_improvement * before, evidence.pooled_words()),
     ]
     ok = all(passed for passed, _ in checks)
     return ok, "; ".join(text for passed, text in checks if ok or not passed)

@@ -875,8 +875,7 @@ def _one_version_each(findings: list[Finding]) -> list[Finding]:
             _name_base_load_not_taken(best, worse)
         else:
             if worse.evidence is not None and "schedule" in worse.detail:
-                pooled = worse.evidence.pooled_after
-                words = f"{worse.detail['schedule']} ({pooled:.3f} K)"
+                words = f"{worse.detail['schedule']}: {_version_words(worse)}"
                 _add_not_taken(best, "schedule_not_taken", words)
             if "follows" in worse.detail and "follows" not in best.detail:
                 _add_not_taken(best, "use_not_taken", _version_words(worse))
@@ -923,9 +922,10 @@ def _ground_words(f: Finding) -> str:
 
 
 def _version_words(f: Finding) -> str:
-    """How a version not taken fared: its pooled test RMSE over the folds, else its verdict."""
+    """How a version not taken fared: its pooled test RMSE on its own folds, before → after and
+    the relative cut the versions are ranked by (``_one_version_each``), else its verdict."""
     if f.evidence is not None:
-        return f"{f.evidence.pooled_after:.3f} K pooled over the folds"
+        return f"{f.evidence.pooled_words()} on its folds"
     return "accepted" if f.accepted else (f.reason or "rejected")
 
 
