@@ -124,6 +124,13 @@ def _local_midnight(first: pd.Timestamp, days: int) -> pd.Timestamp:
 FOLD_TIE_SHARE = 0.02
 
 
+def rmse_change(before: float, after: float) -> str:
+    """A test RMSE [K] from ``before`` to ``after`` in words, with its relative change where
+    there was an error to cut: "test RMSE 0.500 → 0.450 K (-10%)"."""
+    change = f" ({(after - before) / before:+.0%})" if before > 0.0 else ""
+    return f"test RMSE {before:.3f} → {after:.3f} K{change}"
+
+
 @dataclass(frozen=True)
 class FoldEvidence:
     """Test errors of the current model (``before``) and of an extension (``after``) on every
@@ -150,11 +157,8 @@ class FoldEvidence:
         return _rmse(np.concatenate(self.after))
 
     def pooled_words(self) -> str:
-        """The pooled test RMSE before → after and its relative change (none where nothing was
-        left to cut)."""
-        before, after = self.pooled_before, self.pooled_after
-        change = f" ({(after - before) / before:+.0%})" if before > 0.0 else ""
-        return f"pooled test RMSE {before:.3f} → {after:.3f} K{change}"
+        """The pooled test RMSE before → after and its relative change (``rmse_change``)."""
+        return f"pooled {rmse_change(self.pooled_before, self.pooled_after)}"
 
     @property
     def tied(self) -> np.ndarray:

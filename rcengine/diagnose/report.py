@@ -14,7 +14,7 @@ from rcengine.columns import SOLAR_OPAQUE, SOLAR_WINDOW, solar_orientation_signa
 from rcengine.diagnose.candidates import Extension
 from rcengine.diagnose.clock import ClockCheck
 from rcengine.diagnose.fitting import Fit
-from rcengine.diagnose.folds import Fold, FoldEvidence, judge_folds
+from rcengine.diagnose.folds import Fold, FoldEvidence, judge_folds, rmse_change
 from rcengine.diagnose.health import FitQuality, Health
 from rcengine.diagnose.locate import summarize
 from rcengine.diagnose.screen import Screen
@@ -136,17 +136,13 @@ SLOW_INPUT = "slow_input"
 HEATER_OFF = "heater_off"
 
 
-def _test_change(before: float, after: float) -> str:
-    return f"test RMSE {before:.3f} → {after:.3f} K ({(after - before) / before:+.0%})"
-
-
 def improvement_check(
     before: float, after: float, settings: DiagnoseSettings, evident: bool = False
 ) -> tuple[bool, str]:
     """Whether the test RMSE [K] fell from ``before`` to ``after`` by the relative cut and the
     kelvin margin of ``settings``, or, for a fit whose magnitude is ``evident``, by the smaller
     relative cut alone; with the change in words."""
-    gain, text = before - after, _test_change(before, after)
+    gain, text = before - after, rmse_change(before, after)
     if evident:
         cut = settings.min_improvement_evident
         return gain >= cut * before, f"{text}, its magnitude evident (a {cut:.0%} cut asked)"
@@ -290,7 +286,7 @@ def confirm_over_the_season(
             finding.reason += f", {season}"
         finding.accepted = False
         return
-    single = _test_change(finding.rmse_test_before, finding.rmse_test_after)
+    single = rmse_change(finding.rmse_test_before, finding.rmse_test_after)
     if finding.short_of == SHORT_OF_TEST:
         single += " on a test half that is the season's other half"
     finding.reason = (
